@@ -1,0 +1,167 @@
+/*
+ * pyins_core.h: the one public C ABI of the pyins firmware core (C99).
+ *
+ * The core is a marine strapdown INS stepping at a fixed rate (100 Hz by
+ * default). The caller owns all memory: pyins_core_size() says how many bytes
+ * an instance needs, pyins_init() builds it there, and the core never
+ * allocates, throws, prints or keeps global state.
+ *
+ * Frames and units (DESIGN.md section 2): n = East-North-Up, b = ship body
+ * (x starboard, y bow, z up), p = IMU frame on the turntable, C_p^b = Rz(alpha).
+ * SI units: rad, m, s, m/s. Euler angles [pitch, roll, yaw], C_b^n =
+ * Rz(yaw) Rx(pitch) Ry(roll), yaw counter-clockwise from North; heading is the
+ * marine one, clockwise from North in [0, 2 pi).
+ *
+ * Every function that can fail returns PYINS_OK (0) or a negative
+ * pyins_status with a fixed value; pyins_status_str() names it.
+ *
+ * The block between CDEF-BEGIN and CDEF-END is read verbatim by Python's
+ * cffi (pyins/native.py), so it holds no preprocessor lines.
+ */
+#ifndef PYINS_CORE_H
+#define PYINS_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* ABI version: (major << 16) | minor. A major change breaks callers. */
+#define PYINS_ABI_VERSION_MAJOR 0
+#define PYINS_ABI_VERSION_MINOR 1
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(__GNUC__)
+#pragma GCC visibility push(default)
+#endif
+
+/* CDEF-BEGIN */
+
+/* Status codes. The values are fixed: never renumber, only append. */
+enum pyins_status {
+    PYINS_OK = 0,
+    PYINS_E_NULL = -1,              /* a required pointer argument is NULL */
+    PYINS_E_MISALIGNED = -2,        /* instance memory not aligned to pyins_core_align() */
+    PYINS_E_MEM_TOO_SMALL = -3,     /* mem_size < pyins_core_size() */
+    PYINS_E_NOT_INIT = -4,          /* the memory does not hold an initialised instance */
+    PYINS_E_SAMPLE_NONFINITE = -5,  /* a sample field is NaN or Inf; the sample was rejected */
+    PYINS_E_CONFIG_RATE = -10,      /* tick_hz out of range (must be 0 = default, or 1..10000) */
+    PYINS_E_CONFIG_LAT = -11,       /* latitude not finite or beyond +-90 deg */
+    PYINS_E_CONFIG_LON = -12,       /* longitude not finite or beyond +-360 deg */
+    PYINS_E_CONFIG_HEIGHT = -13,    /* height not finite or outside -1e4..1e5 m */
+    PYINS_E_CONFIG_VEL = -14,       /* velocity not finite or faster than 1e4 m/s */
+    PYINS_E_CONFIG_ATT = -15,       /* attitude or table angle not finite */
+    PYINS_E_CONFIG_MODE = -16       /* unknown vertical-channel mode */
+};
+
+/* Vertical channel: a marine INS holds height at the reference (external
+ * height aiding); FREE integrates it (diverges within hours). */
+enum pyins_vertical_mode {
+    PYINS_VERTICAL_HOLD = 0,
+    PYINS_VERTICAL_FREE = 1
+};
+
+/* Firmware configuration. A zeroed struct means the defaults, which
+ * pyins_config_default() also writes. */
+typedef struct pyins_config {
+    int32_t tick_hz;              /* step rate [Hz]; 0 = 100 */
+    int32_t vertical_mode;        /* enum pyins_vertical_mode */
+    double lat_rad;               /* initial geodetic latitude [rad] */
+    double lon_rad;               /* initial longitude [rad] */
+    double height_m;              /* initial height [m]; the HOLD reference */
+    double vel_n_mps[3];          /* initial velocity, ENU [m/s] */
+    double euler_b_rad[3];        /* initial ship attitude [pitch, roll, yaw] [rad] */
+    double table_angle_rad;       /* turntable angle alpha at the initial time [rad] */
+} pyins_config;
+
+/* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
+typedef struct pyins_sample {
+    double dtheta_p_rad[3];       /* angle increment in p [rad] */
+    double dv_p_mps[3];           /* velocity increment in p [m/s] */
+    double table_angle_rad;       /* encoder angle alpha at t_k, wrapped to [0, 2 pi) [rad] */
+} pyins_sample;
+
+/* One output record per step, the state at t_k. */
+typedef struct pyins_output {
+    int64_t tick;                 /* number of samples accepted since init */
+    int32_t mode;                 /* firmware mode (1 = NAVIGATE) */
+    uint32_t fault_flags;         /* bit field, 0 = healthy */
+    double lat_rad;               /* geodetic latitude [rad] */
+    double lon_rad;               /* longitude [rad] */
+    double height_m;              /* height [m] */
+    double vel_n_mps[3];          /* velocity, ENU [m/s] */
+    double quat_nb[4];            /* ship attitude C_b^n as [w, x, y, z], w >= 0 */
+    double quat_np[4];            /* IMU attitude C_p^n as [w, x, y, z], w >= 0 */
+    double euler_b_rad[3];        /* ship [pitch, roll, yaw] [rad], yaw CCW from North */
+    double heading_b_rad;         /* ship heading, clockwise from North, [0, 2 pi) [rad] */
+    double yaw_p_rad;             /* IMU yaw psi_p = psi_b + alpha, CCW, (-pi, pi] [rad] */
+    double table_angle_rad;       /* unwrapped turntable angle alpha [rad] */
+} pyins_output;
+
+/* The firmware instance. Opaque: it lives in caller memory of
+ * pyins_core_size() bytes aligned to pyins_core_align(). */
+typedef struct pyins_core pyins_core;
+
+/* (PYINS_ABI_VERSION_MAJOR << 16) | PYINS_ABI_VERSION_MINOR of the built library. */
+uint32_t pyins_abi_version(void);
+
+/* Library version as a static string, e.g. "0.1.0". Never NULL. */
+const char *pyins_version_string(void);
+
+/* Bytes and alignment a firmware instance needs. */
+size_t pyins_core_size(void);
+size_t pyins_core_align(void);
+
+/* sizeof the public structs as the library was built, for layout checks. */
+size_t pyins_sizeof_config(void);
+size_t pyins_sizeof_sample(void);
+size_t pyins_sizeof_output(void);
+
+/* Write the default configuration into *cfg (a zeroed struct means the same).
+ * Returns PYINS_OK or PYINS_E_NULL. */
+int pyins_config_default(pyins_config *cfg);
+
+/* Check a configuration without building anything.
+ * Returns PYINS_OK or the first negative PYINS_E_CONFIG_* found. */
+int pyins_config_check(const pyins_config *cfg);
+
+/* Build a firmware instance inside mem (mem_size bytes, aligned to
+ * pyins_core_align()); from then on (pyins_core *)mem is the instance.
+ * On failure mem is left as it was. Never allocates.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_init(void *mem, size_t mem_size, const pyins_config *cfg);
+
+/* Advance one tick with one sample and write the output record to *out.
+ * A rejected sample (PYINS_E_SAMPLE_NONFINITE) leaves the state unchanged;
+ * *out then holds the unchanged state.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_step(pyins_core *core, const pyins_sample *sample, pyins_output *out);
+
+/* Step n samples from an array in one call, writing n output records
+ * (outputs may be NULL when only the final state is wanted). Stops at the
+ * first rejected sample; *n_done (if not NULL) receives the number of samples
+ * accepted, so samples[*n_done] is the one rejected. N single steps and one
+ * N-sample call give bit-identical outputs.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_run(pyins_core *core, const pyins_sample *samples, size_t n,
+              pyins_output *outputs, size_t *n_done);
+
+/* Write the current state as an output record (no step).
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_get_output(const pyins_core *core, pyins_output *out);
+
+/* Static, human-readable name and meaning of a status code. Never NULL. */
+const char *pyins_status_str(int status);
+
+/* CDEF-END */
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PYINS_CORE_H */

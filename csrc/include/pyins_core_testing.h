@@ -1,0 +1,87 @@
+/*
+ * pyins_core_testing.h: UNSTABLE, host-only test hooks of the pyins core.
+ *
+ * Pure functions of the core's modules, exported so tests can hold each one
+ * against the NumPy reference (pyins/reference) on random inputs. Built only
+ * with PYINS_TEST_HOOKS (the host library); never part of the stable ABI.
+ * Matrices are 3x3 row-major double[9]; quaternions [w, x, y, z].
+ */
+#ifndef PYINS_CORE_TESTING_H
+#define PYINS_CORE_TESTING_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(__GNUC__)
+#pragma GCC visibility push(default)
+#endif
+
+/* CDEF-BEGIN */
+
+typedef struct pyins_t_earth {
+    double sin_lat, cos_lat, tan_lat, rm_h, rn_h;
+    double omega_ie_n[3], omega_en_n[3], omega_in_n[3], gravity_n[3];
+} pyins_t_earth;
+
+typedef struct pyins_t_strapdown {
+    double lat, lon, height;
+    double vel_n[3];
+    double quat_np[4];
+    double prev_dtheta_p[3], prev_dv_p[3], prev_dvel_n[3];
+    int32_t has_prev;
+    int32_t vertical;
+    double ref_height;
+} pyins_t_strapdown;
+
+/* math_portable */
+double pyins_t_sin(double x);
+double pyins_t_cos(double x);
+double pyins_t_atan2(double y, double x);
+void pyins_t_sin_batch(const double *x, double *out, size_t n);
+void pyins_t_cos_batch(const double *x, double *out, size_t n);
+void pyins_t_atan2_batch(const double *y, const double *x, double *out, size_t n);
+
+/* earth */
+void pyins_t_principal_radii(double sin_lat, double *rm, double *rn);
+double pyins_t_normal_gravity(double sin_lat, double height);
+void pyins_t_earth_at(double sin_lat, double cos_lat, double height,
+                      const double vel_n[3], pyins_t_earth *out);
+void pyins_t_position_rate(double sin_lat, double cos_lat, double height,
+                           const double vel_n[3], double out[3]);
+
+/* attitude */
+void pyins_t_quat_mul(const double p[4], const double q[4], double out[4]);
+void pyins_t_quat_normalize(const double q[4], double out[4]);
+void pyins_t_quat_to_mat(const double q[4], double m[9]);
+void pyins_t_mat_to_quat(const double m[9], double q[4]);
+void pyins_t_rotvec_to_quat(const double v[3], double q[4]);
+void pyins_t_quat_to_rotvec(const double q[4], double v[3]);
+void pyins_t_rot_z(double angle, double m[9]);
+void pyins_t_euler_to_mat(const double euler[3], double m[9]);
+void pyins_t_mat_to_euler(const double m[9], double euler[3]);
+void pyins_t_mat_orthonormalize(const double m[9], double out[9]);
+double pyins_t_yaw_to_heading(double yaw);
+double pyins_t_heading_to_yaw(double heading);
+
+/* strapdown */
+void pyins_t_compensate(const double dtheta[3], const double dv[3],
+                        const double prev_dtheta[3], const double prev_dv[3],
+                        double phi[3], double dv_p[3]);
+void pyins_t_strapdown_update(pyins_t_strapdown *s, const double dtheta_p[3],
+                              const double dv_p[3], double dt);
+
+/* CDEF-END */
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PYINS_CORE_TESTING_H */

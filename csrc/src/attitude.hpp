@@ -1,0 +1,53 @@
+// attitude.hpp: quaternions, DCMs, Euler angles, rotation vectors.
+//
+// Mirrored by pyins/reference/attitude.py (same names, same operation order).
+// Conventions (DESIGN.md 2): Hamilton quaternions [w, x, y, z]; quat_nb and
+// mat_nb map b to n; Euler [pitch, roll, yaw] with C_b^n = Rz(yaw) Rx(pitch)
+// Ry(roll); yaw counter-clockwise from North; heading = (-yaw) mod 2 pi.
+//
+// References: Qin Yongyuan, "Inertial Navigation" (2014) secs. 9.1-9.2;
+// Shepperd (1978), J. Guidance 1(3) (quaternion from a rotation matrix).
+#pragma once
+
+#include "types.hpp"
+
+namespace pyins::attitude {
+
+/// Below this squared angle [rad^2] rotvec_to_quat uses its Taylor series;
+/// at 1e-3 rad the first omitted terms are ~1e-23 relative (far below an ulp).
+inline constexpr double kRotvecSeries2 = 1e-6;
+
+Mat3 skew(const Vec3& v);
+/// a x b, written out so the operation order is the reference's.
+Vec3 cross(const Vec3& a, const Vec3& b);
+
+Quat quat_mul(const Quat& p, const Quat& q);
+Quat quat_conj(const Quat& q);
+/// Unit quaternion with non-negative scalar part.
+Quat quat_normalize(const Quat& q);
+/// C from a unit quaternion. Qin (2014) eq. 9.2.34.
+Mat3 quat_to_mat(const Quat& q);
+/// Unit quaternion (w >= 0) from a rotation matrix, Shepperd's method.
+Quat mat_to_quat(const Mat3& m);
+/// Quaternion of a rotation vector. Qin (2014) eq. 9.2.44; series branch
+/// when |v|^2 < kRotvecSeries2.
+Quat rotvec_to_quat(const Vec3& v);
+/// Rotation vector of a unit quaternion, angle in [0, pi].
+Vec3 quat_to_rotvec(const Quat& q);
+Mat3 rotvec_to_mat(const Vec3& v);
+/// Rz(angle), counter-clockwise about +z; C_p^b = rot_z(alpha).
+Mat3 rot_z(double angle);
+/// C_b^n = Rz(yaw) Rx(pitch) Ry(roll) from [pitch, roll, yaw].
+Mat3 euler_to_mat(const Vec3& euler);
+/// [pitch, roll, yaw] from C_b^n; pitch in [-pi/2, pi/2]. Qin (2014) 9.1.26.
+Vec3 mat_to_euler(const Mat3& m);
+Quat euler_to_quat(const Vec3& euler);
+Vec3 quat_to_euler(const Quat& q);
+/// Nearest proper rotation, through the normalised Shepperd quaternion.
+Mat3 mat_orthonormalize(const Mat3& m);
+/// Marine heading in [0, 2 pi), clockwise from North, from yaw.
+double yaw_to_heading(double yaw);
+/// Yaw in (-pi, pi], counter-clockwise from North, from marine heading.
+double heading_to_yaw(double heading);
+
+}  // namespace pyins::attitude

@@ -1,0 +1,307 @@
+// c_api.cpp: the only translation unit that implements pyins_core.h (and,
+// on the host with PYINS_TEST_HOOKS, pyins_core_testing.h).
+//
+// Every entry point checks its pointers, sizes and alignment before any C++
+// runs, and reports through a negative status; nothing here can throw,
+// allocate or print.
+#include "pyins_core.h"
+
+#include <cstdint>
+#include <new>
+
+#include "firmware.hpp"
+
+using pyins::firmware::Firmware;
+
+static_assert(sizeof(pyins_sample) == 7 * sizeof(double), "pyins_sample layout");
+static_assert(alignof(Firmware) <= 16, "instance alignment");
+
+namespace {
+
+bool is_aligned(const void* p, size_t align) {
+    return (reinterpret_cast<uintptr_t>(p) % align) == 0u;
+}
+
+/// The instance behind a handle, or a negative status.
+int checked(const pyins_core* core, const Firmware** fw) {
+    if (core == nullptr) {
+        return PYINS_E_NULL;
+    }
+    if (!is_aligned(core, alignof(Firmware))) {
+        return PYINS_E_MISALIGNED;
+    }
+    const Firmware* f = reinterpret_cast<const Firmware*>(core);
+    if (f->magic() != pyins::firmware::kMagic) {
+        return PYINS_E_NOT_INIT;
+    }
+    *fw = f;
+    return PYINS_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+uint32_t pyins_abi_version(void) {
+    return (static_cast<uint32_t>(PYINS_ABI_VERSION_MAJOR) << 16) |
+           static_cast<uint32_t>(PYINS_ABI_VERSION_MINOR);
+}
+
+const char* pyins_version_string(void) { return "0.1.0"; }
+
+size_t pyins_core_size(void) { return sizeof(Firmware); }
+size_t pyins_core_align(void) { return alignof(Firmware); }
+size_t pyins_sizeof_config(void) { return sizeof(pyins_config); }
+size_t pyins_sizeof_sample(void) { return sizeof(pyins_sample); }
+size_t pyins_sizeof_output(void) { return sizeof(pyins_output); }
+
+int pyins_config_default(pyins_config* cfg) {
+    if (cfg == nullptr) {
+        return PYINS_E_NULL;
+    }
+    pyins::firmware::config_default(cfg);
+    return PYINS_OK;
+}
+
+int pyins_config_check(const pyins_config* cfg) {
+    if (cfg == nullptr) {
+        return PYINS_E_NULL;
+    }
+    return pyins::firmware::config_check(*cfg);
+}
+
+int pyins_init(void* mem, size_t mem_size, const pyins_config* cfg) {
+    if (mem == nullptr || cfg == nullptr) {
+        return PYINS_E_NULL;
+    }
+    if (!is_aligned(mem, alignof(Firmware))) {
+        return PYINS_E_MISALIGNED;
+    }
+    if (mem_size < sizeof(Firmware)) {
+        return PYINS_E_MEM_TOO_SMALL;
+    }
+    const int status = pyins::firmware::config_check(*cfg);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    Firmware* fw = new (mem) Firmware;  // placement new: no allocation
+    fw->init(*cfg);
+    return PYINS_OK;
+}
+
+int pyins_step(pyins_core* core, const pyins_sample* sample, pyins_output* out) {
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (sample == nullptr || out == nullptr) {
+        return PYINS_E_NULL;
+    }
+    return const_cast<Firmware*>(cfw)->step(*sample, out);
+}
+
+int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
+              pyins_output* outputs, size_t* n_done) {
+    if (n_done != nullptr) {
+        *n_done = 0;
+    }
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (samples == nullptr && n > 0u) {
+        return PYINS_E_NULL;
+    }
+    Firmware* fw = const_cast<Firmware*>(cfw);
+    for (size_t i = 0; i < n; ++i) {
+        const int s = fw->step(samples[i], outputs != nullptr ? &outputs[i] : nullptr);
+        if (s != PYINS_OK) {
+            return s;
+        }
+        if (n_done != nullptr) {
+            *n_done = i + 1u;
+        }
+    }
+    return PYINS_OK;
+}
+
+int pyins_get_output(const pyins_core* core, pyins_output* out) {
+    const Firmware* fw = nullptr;
+    const int status = checked(core, &fw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (out == nullptr) {
+        return PYINS_E_NULL;
+    }
+    fw->output(out);
+    return PYINS_OK;
+}
+
+const char* pyins_status_str(int status) {
+    switch (status) {
+        case PYINS_OK: return "PYINS_OK: success";
+        case PYINS_E_NULL: return "PYINS_E_NULL: a required pointer argument is NULL";
+        case PYINS_E_MISALIGNED: return "PYINS_E_MISALIGNED: instance memory is not aligned to pyins_core_align()";
+        case PYINS_E_MEM_TOO_SMALL: return "PYINS_E_MEM_TOO_SMALL: memory is smaller than pyins_core_size()";
+        case PYINS_E_NOT_INIT: return "PYINS_E_NOT_INIT: the memory does not hold an initialised instance";
+        case PYINS_E_SAMPLE_NONFINITE: return "PYINS_E_SAMPLE_NONFINITE: a sample field is NaN or Inf; sample rejected, state unchanged";
+        case PYINS_E_CONFIG_RATE: return "PYINS_E_CONFIG_RATE: tick_hz must be 0 (default 100) or 1..10000";
+        case PYINS_E_CONFIG_LAT: return "PYINS_E_CONFIG_LAT: latitude must be finite and within +-89.9 deg (ENU is singular at the poles)";
+        case PYINS_E_CONFIG_LON: return "PYINS_E_CONFIG_LON: longitude must be finite and within +-720 deg";
+        case PYINS_E_CONFIG_HEIGHT: return "PYINS_E_CONFIG_HEIGHT: height must be finite and within -1e4..1e5 m";
+        case PYINS_E_CONFIG_VEL: return "PYINS_E_CONFIG_VEL: velocity must be finite and below 1e4 m/s per axis";
+        case PYINS_E_CONFIG_ATT: return "PYINS_E_CONFIG_ATT: attitude angles and table angle must be finite";
+        case PYINS_E_CONFIG_MODE: return "PYINS_E_CONFIG_MODE: vertical_mode must be PYINS_VERTICAL_HOLD or PYINS_VERTICAL_FREE";
+        default: return "unknown pyins status code";
+    }
+}
+
+}  // extern "C"
+
+// ---------------------------------------------------------------------------
+// Test hooks (pyins_core_testing.h), host only.
+#if defined(PYINS_TEST_HOOKS) && PYINS_TEST_HOOKS
+#include "attitude.hpp"
+#include "earth.hpp"
+#include "math_portable.hpp"
+#include "pyins_core_testing.h"
+#include "strapdown.hpp"
+
+namespace {
+
+using pyins::Mat3;
+using pyins::Quat;
+using pyins::Vec3;
+
+Vec3 v3(const double* a) { return Vec3(a[0], a[1], a[2]); }
+void put3(const Vec3& v, double* a) { a[0] = v(0); a[1] = v(1); a[2] = v(2); }
+Quat q4(const double* a) { return Quat{a[0], a[1], a[2], a[3]}; }
+void put4(const Quat& q, double* a) { a[0] = q.w; a[1] = q.x; a[2] = q.y; a[3] = q.z; }
+Mat3 m9(const double* a) {
+    Mat3 m;
+    m << a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8];
+    return m;
+}
+void put9(const Mat3& m, double* a) {
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            a[3 * i + j] = m(i, j);
+        }
+    }
+}
+
+}  // namespace
+
+extern "C" {
+
+double pyins_t_sin(double x) { return pyins::pmath::sin(x); }
+double pyins_t_cos(double x) { return pyins::pmath::cos(x); }
+double pyins_t_atan2(double y, double x) { return pyins::pmath::atan2(y, x); }
+void pyins_t_sin_batch(const double* x, double* out, size_t n) {
+    for (size_t i = 0; i < n; ++i) out[i] = pyins::pmath::sin(x[i]);
+}
+void pyins_t_cos_batch(const double* x, double* out, size_t n) {
+    for (size_t i = 0; i < n; ++i) out[i] = pyins::pmath::cos(x[i]);
+}
+void pyins_t_atan2_batch(const double* y, const double* x, double* out, size_t n) {
+    for (size_t i = 0; i < n; ++i) out[i] = pyins::pmath::atan2(y[i], x[i]);
+}
+
+void pyins_t_principal_radii(double sin_lat, double* rm, double* rn) {
+    const pyins::earth::PrincipalRadii r = pyins::earth::principal_radii(sin_lat);
+    *rm = r.rm;
+    *rn = r.rn;
+}
+double pyins_t_normal_gravity(double sin_lat, double height) {
+    return pyins::earth::normal_gravity(sin_lat, height);
+}
+void pyins_t_earth_at(double sin_lat, double cos_lat, double height, const double vel_n[3],
+                      pyins_t_earth* out) {
+    const pyins::earth::Earth e = pyins::earth::earth_at(sin_lat, cos_lat, height, v3(vel_n));
+    out->sin_lat = e.sin_lat;
+    out->cos_lat = e.cos_lat;
+    out->tan_lat = e.tan_lat;
+    out->rm_h = e.rm_h;
+    out->rn_h = e.rn_h;
+    put3(e.omega_ie_n, out->omega_ie_n);
+    put3(e.omega_en_n, out->omega_en_n);
+    put3(e.omega_in_n, out->omega_in_n);
+    put3(e.gravity_n, out->gravity_n);
+}
+void pyins_t_position_rate(double sin_lat, double cos_lat, double height, const double vel_n[3],
+                           double out[3]) {
+    const pyins::earth::Earth e = pyins::earth::earth_at(sin_lat, cos_lat, height, v3(vel_n));
+    put3(pyins::earth::position_rate(e, v3(vel_n)), out);
+}
+
+void pyins_t_quat_mul(const double p[4], const double q[4], double out[4]) {
+    put4(pyins::attitude::quat_mul(q4(p), q4(q)), out);
+}
+void pyins_t_quat_normalize(const double q[4], double out[4]) {
+    put4(pyins::attitude::quat_normalize(q4(q)), out);
+}
+void pyins_t_quat_to_mat(const double q[4], double m[9]) {
+    put9(pyins::attitude::quat_to_mat(q4(q)), m);
+}
+void pyins_t_mat_to_quat(const double m[9], double q[4]) {
+    put4(pyins::attitude::mat_to_quat(m9(m)), q);
+}
+void pyins_t_rotvec_to_quat(const double v[3], double q[4]) {
+    put4(pyins::attitude::rotvec_to_quat(v3(v)), q);
+}
+void pyins_t_quat_to_rotvec(const double q[4], double v[3]) {
+    put3(pyins::attitude::quat_to_rotvec(q4(q)), v);
+}
+void pyins_t_rot_z(double angle, double m[9]) { put9(pyins::attitude::rot_z(angle), m); }
+void pyins_t_euler_to_mat(const double euler[3], double m[9]) {
+    put9(pyins::attitude::euler_to_mat(v3(euler)), m);
+}
+void pyins_t_mat_to_euler(const double m[9], double euler[3]) {
+    put3(pyins::attitude::mat_to_euler(m9(m)), euler);
+}
+void pyins_t_mat_orthonormalize(const double m[9], double out[9]) {
+    put9(pyins::attitude::mat_orthonormalize(m9(m)), out);
+}
+double pyins_t_yaw_to_heading(double yaw) { return pyins::attitude::yaw_to_heading(yaw); }
+double pyins_t_heading_to_yaw(double heading) { return pyins::attitude::heading_to_yaw(heading); }
+
+void pyins_t_compensate(const double dtheta[3], const double dv[3], const double prev_dtheta[3],
+                        const double prev_dv[3], double phi[3], double dv_p[3]) {
+    const pyins::strapdown::Compensated c =
+        pyins::strapdown::compensate(v3(dtheta), v3(dv), v3(prev_dtheta), v3(prev_dv));
+    put3(c.phi, phi);
+    put3(c.dv_p, dv_p);
+}
+
+void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], const double dv_p[3],
+                              double dt) {
+    pyins::strapdown::Strapdown sd;
+    sd.nav.lat = s->lat;
+    sd.nav.lon = s->lon;
+    sd.nav.height = s->height;
+    sd.nav.vel_n = v3(s->vel_n);
+    sd.nav.quat_np = q4(s->quat_np);
+    sd.prev_dtheta_p = v3(s->prev_dtheta_p);
+    sd.prev_dv_p = v3(s->prev_dv_p);
+    sd.prev_dvel_n = v3(s->prev_dvel_n);
+    sd.has_prev = s->has_prev != 0;
+    sd.vertical = s->vertical == 1 ? pyins::strapdown::Vertical::kFree
+                                   : pyins::strapdown::Vertical::kHold;
+    sd.ref_height = s->ref_height;
+    pyins::strapdown::update(sd, v3(dtheta_p), v3(dv_p), dt);
+    s->lat = sd.nav.lat;
+    s->lon = sd.nav.lon;
+    s->height = sd.nav.height;
+    put3(sd.nav.vel_n, s->vel_n);
+    put4(sd.nav.quat_np, s->quat_np);
+    put3(sd.prev_dtheta_p, s->prev_dtheta_p);
+    put3(sd.prev_dv_p, s->prev_dv_p);
+    put3(sd.prev_dvel_n, s->prev_dvel_n);
+    s->has_prev = sd.has_prev ? 1 : 0;
+}
+
+}  // extern "C"
+#endif  // PYINS_TEST_HOOKS

@@ -1,0 +1,45 @@
+// earth.cpp: see earth.hpp. Mirrored by pyins/reference/earth.py.
+#include "earth.hpp"
+
+#include "math_portable.hpp"
+
+namespace pyins::earth {
+
+PrincipalRadii principal_radii(double sin_lat) {
+    const double x = 1.0 - kE2 * sin_lat * sin_lat;
+    const double sqrt_x = pmath::sqrt(x);
+    const double rn = kA / sqrt_x;
+    const double rm = rn * (1.0 - kE2) / x;
+    return {rm, rn};
+}
+
+double normal_gravity(double sin_lat, double height) {
+    const double s2 = sin_lat * sin_lat;
+    const double gamma0 = kGammaE * (1.0 + kSomigliana * s2) / pmath::sqrt(1.0 - kE2 * s2);
+    const double c1 = 2.0 / kA * (1.0 + kF + kMGrav - 2.0 * kF * s2);
+    const double c2 = 3.0 / (kA * kA);
+    return gamma0 * (1.0 - c1 * height + c2 * height * height);
+}
+
+Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n) {
+    const PrincipalRadii r = principal_radii(sin_lat);
+    Earth e;
+    e.sin_lat = sin_lat;
+    e.cos_lat = cos_lat;
+    e.rm_h = r.rm + height;
+    e.rn_h = r.rn + height;
+    e.tan_lat = sin_lat / cos_lat;
+    e.omega_ie_n = Vec3(0.0, kOmegaIe * cos_lat, kOmegaIe * sin_lat);
+    e.omega_en_n = Vec3(-vel_n(1) / e.rm_h, vel_n(0) / e.rn_h, vel_n(0) / e.rn_h * e.tan_lat);
+    e.omega_in_n = e.omega_ie_n + e.omega_en_n;
+    e.gravity_n = Vec3(0.0, 0.0, -normal_gravity(sin_lat, height));
+    return e;
+}
+
+Vec3 position_rate(const Earth& earth, const Vec3& vel_n) {
+    const double lat_dot = vel_n(1) / earth.rm_h;
+    const double lon_dot = vel_n(0) / (earth.rn_h * earth.cos_lat);
+    return Vec3(lat_dot, lon_dot, vel_n(2));
+}
+
+}  // namespace pyins::earth

@@ -1,0 +1,159 @@
+// firmware.cpp: see firmware.hpp. Mirrored by pyins/reference/firmware.py.
+#include "firmware.hpp"
+
+#include <cmath>
+
+#include "attitude.hpp"
+#include "earth.hpp"
+#include "math_portable.hpp"
+
+namespace pyins::firmware {
+
+using earth::kPi;
+using earth::kTwoPi;
+
+namespace {
+
+bool finite3(const double v[3]) {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+/// Angle in [0, 2 pi). std::floor is exact, so this is bit-portable.
+double wrap_two_pi(double a) {
+    double w = a - kTwoPi * std::floor(a / kTwoPi);
+    if (w >= kTwoPi) {
+        w = 0.0;
+    }
+    return w;
+}
+
+/// Angle in (-pi, pi] for an input within (-3 pi, 3 pi].
+double wrap_pi(double a) {
+    if (a > kPi) {
+        return a - kTwoPi;
+    }
+    if (a <= -kPi) {
+        return a + kTwoPi;
+    }
+    return a;
+}
+
+}  // namespace
+
+void config_default(pyins_config* cfg) {
+    *cfg = pyins_config{};
+    cfg->tick_hz = kDefaultTickHz;
+    cfg->vertical_mode = PYINS_VERTICAL_HOLD;
+}
+
+int config_check(const pyins_config& cfg) {
+    if (cfg.tick_hz < 0 || cfg.tick_hz > kMaxTickHz) {
+        return PYINS_E_CONFIG_RATE;
+    }
+    if (!std::isfinite(cfg.lat_rad) || std::fabs(cfg.lat_rad) > kMaxLatRad) {
+        return PYINS_E_CONFIG_LAT;
+    }
+    if (!std::isfinite(cfg.lon_rad) || std::fabs(cfg.lon_rad) > 2.0 * kTwoPi) {
+        return PYINS_E_CONFIG_LON;
+    }
+    if (!std::isfinite(cfg.height_m) || cfg.height_m < -1e4 || cfg.height_m > 1e5) {
+        return PYINS_E_CONFIG_HEIGHT;
+    }
+    if (!finite3(cfg.vel_n_mps) || std::fabs(cfg.vel_n_mps[0]) > 1e4 ||
+        std::fabs(cfg.vel_n_mps[1]) > 1e4 || std::fabs(cfg.vel_n_mps[2]) > 1e4) {
+        return PYINS_E_CONFIG_VEL;
+    }
+    if (!finite3(cfg.euler_b_rad) || !std::isfinite(cfg.table_angle_rad)) {
+        return PYINS_E_CONFIG_ATT;
+    }
+    if (cfg.vertical_mode != PYINS_VERTICAL_HOLD && cfg.vertical_mode != PYINS_VERTICAL_FREE) {
+        return PYINS_E_CONFIG_MODE;
+    }
+    return PYINS_OK;
+}
+
+void Firmware::init(const pyins_config& cfg) {
+    const int32_t hz = cfg.tick_hz == 0 ? kDefaultTickHz : cfg.tick_hz;
+    dt_ = 1.0 / static_cast<double>(hz);
+    mode_ = Mode::kNavigate;
+    tick_ = 0;
+    table_angle_ = cfg.table_angle_rad;
+    encoder_ = wrap_two_pi(cfg.table_angle_rad);
+
+    // The IMU frame at t0: C_p^n = C_b^n C_p^b = C_b^n Rz(alpha).
+    const Vec3 euler_b(cfg.euler_b_rad[0], cfg.euler_b_rad[1], cfg.euler_b_rad[2]);
+    const Mat3 mat_np = attitude::euler_to_mat(euler_b) * attitude::rot_z(encoder_);
+    strapdown::NavState nav;
+    nav.lat = cfg.lat_rad;
+    nav.lon = (cfg.lon_rad > kPi || cfg.lon_rad <= -kPi) ? wrap_pi(wrap_two_pi(cfg.lon_rad))
+                                                        : cfg.lon_rad;
+    nav.height = cfg.height_m;
+    nav.vel_n = Vec3(cfg.vel_n_mps[0], cfg.vel_n_mps[1], cfg.vel_n_mps[2]);
+    nav.quat_np = attitude::mat_to_quat(mat_np);
+    const strapdown::Vertical vertical = cfg.vertical_mode == PYINS_VERTICAL_FREE
+                                             ? strapdown::Vertical::kFree
+                                             : strapdown::Vertical::kHold;
+    sd_ = strapdown::make_strapdown(nav, vertical);
+    magic_ = kMagic;
+}
+
+int Firmware::step(const pyins_sample& sample, pyins_output* out) {
+    if (!finite3(sample.dtheta_p_rad) || !finite3(sample.dv_p_mps) ||
+        !std::isfinite(sample.table_angle_rad)) {
+        if (out != nullptr) {
+            output(out);
+        }
+        return PYINS_E_SAMPLE_NONFINITE;
+    }
+    const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
+    const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
+    strapdown::update(sd_, dtheta_p, dv_p, dt_);
+
+    // Unwrap the encoder: the table turns far less than pi per tick.
+    const double encoder = wrap_two_pi(sample.table_angle_rad);
+    table_angle_ = table_angle_ + wrap_pi(encoder - encoder_);
+    encoder_ = encoder;
+    tick_ = tick_ + 1;
+    if (out != nullptr) {
+        output(out);
+    }
+    return PYINS_OK;
+}
+
+void Firmware::output(pyins_output* out) const {
+    const strapdown::NavState& nav = sd_.nav;
+    out->tick = tick_;
+    out->mode = static_cast<int32_t>(mode_);
+    out->fault_flags = 0u;
+    out->lat_rad = nav.lat;
+    out->lon_rad = nav.lon;
+    out->height_m = nav.height;
+    out->vel_n_mps[0] = nav.vel_n(0);
+    out->vel_n_mps[1] = nav.vel_n(1);
+    out->vel_n_mps[2] = nav.vel_n(2);
+
+    // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
+    // measured (encoder) angle: q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)].
+    double s;
+    double c;
+    pmath::sincos(0.5 * encoder_, &s, &c);
+    const Quat q_pb{c, 0.0, 0.0, -s};
+    const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(nav.quat_np, q_pb));
+    const Vec3 euler_b = attitude::quat_to_euler(q_nb);
+    out->quat_nb[0] = q_nb.w;
+    out->quat_nb[1] = q_nb.x;
+    out->quat_nb[2] = q_nb.y;
+    out->quat_nb[3] = q_nb.z;
+    out->quat_np[0] = nav.quat_np.w;
+    out->quat_np[1] = nav.quat_np.x;
+    out->quat_np[2] = nav.quat_np.y;
+    out->quat_np[3] = nav.quat_np.z;
+    out->euler_b_rad[0] = euler_b(0);
+    out->euler_b_rad[1] = euler_b(1);
+    out->euler_b_rad[2] = euler_b(2);
+    out->heading_b_rad = attitude::yaw_to_heading(euler_b(2));
+    out->yaw_p_rad = wrap_pi(euler_b(2) + encoder_);
+    out->table_angle_rad = table_angle_;
+}
+
+}  // namespace pyins::firmware

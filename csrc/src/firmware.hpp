@@ -1,0 +1,56 @@
+// firmware.hpp: the firmware instance: configuration, mode, one step.
+//
+// Mirrored by pyins/reference/firmware.py. In this first form the firmware
+// navigates from the configured initial state (mode NAVIGATE); alignment
+// and indexing extend the same instance.
+#pragma once
+
+#include <cstdint>
+
+#include "pyins_core.h"
+#include "strapdown.hpp"
+#include "types.hpp"
+
+namespace pyins::firmware {
+
+/// Firmware modes, as reported in pyins_output.mode.
+enum class Mode : int32_t { kIdle = 0, kNavigate = 1 };
+
+inline constexpr int32_t kDefaultTickHz = 100;
+inline constexpr int32_t kMaxTickHz = 10000;
+/// The ENU frame is singular at the poles: latitudes beyond this are refused.
+inline constexpr double kMaxLatRad = 89.9 * 3.14159265358979323846 / 180.0;
+/// "PYNS": marks memory that holds an initialised instance.
+inline constexpr uint32_t kMagic = 0x50594E53u;
+
+/// Fill *cfg with the defaults (equal to a zeroed config).
+void config_default(pyins_config* cfg);
+
+/// PYINS_OK or the first PYINS_E_CONFIG_* that applies.
+int config_check(const pyins_config& cfg);
+
+class Firmware {
+  public:
+    /// Precondition: config_check(cfg) == PYINS_OK.
+    void init(const pyins_config& cfg);
+
+    /// One tick. Rejects a non-finite sample and leaves the state unchanged.
+    /// Always fills *out (when not null) with the state after the call.
+    int step(const pyins_sample& sample, pyins_output* out);
+
+    /// The current state as an output record.
+    void output(pyins_output* out) const;
+
+    uint32_t magic() const { return magic_; }
+
+  private:
+    uint32_t magic_;
+    Mode mode_;
+    int64_t tick_;
+    double dt_;                   ///< tick period [s]
+    strapdown::Strapdown sd_;
+    double table_angle_;          ///< unwrapped turntable angle alpha [rad]
+    double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]
+};
+
+}  // namespace pyins::firmware

@@ -1,0 +1,98 @@
+// strapdown.cpp: see strapdown.hpp. Mirrored by pyins/reference/strapdown.py.
+#include "strapdown.hpp"
+
+#include "attitude.hpp"
+#include "earth.hpp"
+#include "math_portable.hpp"
+
+namespace pyins::strapdown {
+
+using attitude::cross;
+
+Compensated compensate(const Vec3& dtheta, const Vec3& dv,
+                       const Vec3& prev_dtheta, const Vec3& prev_dv) {
+    Compensated c;
+    c.phi = dtheta + cross(prev_dtheta, dtheta) / 12.0;
+    const Vec3 dv_rot = 0.5 * cross(dtheta, dv);
+    const Vec3 dv_scul = (cross(prev_dtheta, dv) + cross(prev_dv, dtheta)) / 12.0;
+    c.dv_p = dv + dv_rot + dv_scul;
+    return c;
+}
+
+Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
+    Strapdown s;
+    s.nav = nav;
+    s.prev_dtheta_p = Vec3::Zero();
+    s.prev_dv_p = Vec3::Zero();
+    s.prev_dvel_n = Vec3::Zero();
+    s.has_prev = false;
+    s.vertical = vertical;
+    s.ref_height = nav.height;
+    if (vertical == Vertical::kHold) {
+        s.nav.vel_n(2) = 0.0;
+    }
+    return s;
+}
+
+void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
+    // 1. Coning, sculling and rotation compensation. Before the first tick
+    //    there is no previous sample: using the current one makes both
+    //    corrections exactly zero (constant-rate assumption).
+    const Vec3 prev_dtheta = s.has_prev ? s.prev_dtheta_p : dtheta_p;
+    const Vec3 prev_dv = s.has_prev ? s.prev_dv_p : dv_p;
+    const Compensated c = compensate(dtheta_p, dv_p, prev_dtheta, prev_dv);
+
+    // 2. Earth quantities at the start position with the velocity
+    //    extrapolated to mid-tick (Yan 2019 sec. 4.1.4). The position is not
+    //    extrapolated: half a tick moves a ship < 0.1 m, which changes
+    //    gravity by < 1e-9 m/s^2.
+    const Vec3 vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n;
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(s.nav.lat, &sin_lat, &cos_lat);
+    const earth::Earth e = earth::earth_at(sin_lat, cos_lat, s.nav.height, vel_mid);
+
+    // 3. Velocity: specific force rotated into n with the rotation of n over
+    //    the tick, then gravity and Coriolis (Yan 2019 eq. 4.1.27).
+    const Mat3 mat_np = attitude::quat_to_mat(s.nav.quat_np);
+    const Vec3 dv_n0 = mat_np * c.dv_p;
+    const Vec3 dv_sf_n = dv_n0 - 0.5 * dt * cross(e.omega_in_n, dv_n0);
+    const Vec3 coriolis_n = cross(2.0 * e.omega_ie_n + e.omega_en_n, vel_mid);
+    const Vec3 dv_cor_n = (e.gravity_n - coriolis_n) * dt;
+    Vec3 vel_new = s.nav.vel_n + dv_sf_n + dv_cor_n;
+    if (s.vertical == Vertical::kHold) {
+        vel_new(2) = 0.0;
+    }
+
+    // 4. Position by the trapezoidal rule (Qin 2014 eq. 4.1.12).
+    const Vec3 vel_avg = 0.5 * (s.nav.vel_n + vel_new);
+    const Vec3 pos_rate = earth::position_rate(e, vel_avg);
+    s.nav.lat = s.nav.lat + pos_rate(0) * dt;
+    double lon = s.nav.lon + pos_rate(1) * dt;
+    if (lon > earth::kPi) {
+        lon = lon - earth::kTwoPi;
+    } else if (lon <= -earth::kPi) {
+        lon = lon + earth::kTwoPi;
+    }
+    s.nav.lon = lon;
+    if (s.vertical == Vertical::kHold) {
+        s.nav.height = s.ref_height;
+    } else {
+        s.nav.height = s.nav.height + pos_rate(2) * dt;
+    }
+
+    // 5. Attitude: q_np(k) = q(-T omega_in^n) q_np(k-1) q(phi) (Yan eq. 4.1.8).
+    const Quat q_nn = attitude::rotvec_to_quat(-dt * e.omega_in_n);
+    const Quat q_pp = attitude::rotvec_to_quat(c.phi);
+    s.nav.quat_np = attitude::quat_normalize(
+        attitude::quat_mul(attitude::quat_mul(q_nn, s.nav.quat_np), q_pp));
+
+    // 6. Memory for the next tick.
+    s.prev_dvel_n = vel_new - s.nav.vel_n;
+    s.nav.vel_n = vel_new;
+    s.prev_dtheta_p = dtheta_p;
+    s.prev_dv_p = dv_p;
+    s.has_prev = true;
+}
+
+}  // namespace pyins::strapdown

@@ -1,0 +1,315 @@
+"""cffi (ABI mode) binding of the built firmware core.
+
+The library ``libpyins_core.so`` and its headers are installed inside the
+``pyins`` package by ``pip install .``; the cdef is read from the installed
+``pyins_core.h`` (see ``pyins._cdef``), and the library's ABI version and
+struct sizes are checked at import, so a stale build fails loudly here and
+not later with corrupted memory.
+
+``PYINS_CORE_LIB=/path/to/libpyins_core.so`` loads another build (its
+headers are taken from beside it, else from the source tree).
+"""
+import importlib.resources
+import os
+from pathlib import Path
+
+import cffi
+import numpy as np
+
+from ._cdef import read_cdef
+
+#: The ABI this Python code was written against: (major, minor).
+EXPECTED_ABI = (0, 1)
+
+_LIB_NAME = "libpyins_core.so"
+_HEADERS = ("pyins_core.h", "pyins_core_testing.h")
+_REBUILD = "run `pip install .` (or `bash tools/setup.sh`) in the pyins source tree to build it"
+
+
+def _package_file(name):
+    return importlib.resources.files("pyins") / name
+
+
+def _locate():
+    """Paths (library, {header name: header text})."""
+    override = os.environ.get("PYINS_CORE_LIB")
+    lib_path = Path(override) if override else _package_file(_LIB_NAME)
+    if not lib_path.is_file():
+        where = f"PYINS_CORE_LIB={override}" if override else "inside the installed pyins package"
+        raise ImportError(f"pyins: the firmware core library {_LIB_NAME} was not found {where}; {_REBUILD}.")
+    texts = {}
+    source_include = Path(__file__).resolve().parent.parent / "csrc" / "include"
+    for name in _HEADERS:
+        candidates = [Path(str(lib_path)).parent / name] if override else [_package_file(name)]
+        candidates.append(source_include / name)
+        for c in candidates:
+            if c.is_file():
+                texts[name] = c.read_text()
+                break
+    if "pyins_core.h" not in texts:
+        raise ImportError(f"pyins: pyins_core.h was not found next to {lib_path}; {_REBUILD}.")
+    return lib_path, texts
+
+
+def _load():
+    lib_path, texts = _locate()
+    ffi = cffi.FFI()
+    ffi.cdef(read_cdef(texts["pyins_core.h"]))
+    has_hooks = "pyins_core_testing.h" in texts
+    if has_hooks:
+        ffi.cdef(read_cdef(texts["pyins_core_testing.h"]))
+    try:
+        lib = ffi.dlopen(str(lib_path))
+    except OSError as exc:
+        raise ImportError(f"pyins: cannot load {lib_path}: {exc}; {_REBUILD}.") from exc
+    try:
+        abi = lib.pyins_abi_version()
+    except AttributeError as exc:
+        raise ImportError(f"pyins: {lib_path} is not a pyins core library; {_REBUILD}.") from exc
+    got = (abi >> 16, abi & 0xFFFF)
+    if got != EXPECTED_ABI:
+        raise ImportError(f"pyins: the core library {lib_path} has ABI {got[0]}.{got[1]} but this "
+                          f"pyins expects {EXPECTED_ABI[0]}.{EXPECTED_ABI[1]}; {_REBUILD}.")
+    for struct, fn in (("pyins_config", lib.pyins_sizeof_config),
+                       ("pyins_sample", lib.pyins_sizeof_sample),
+                       ("pyins_output", lib.pyins_sizeof_output)):
+        if ffi.sizeof(struct) != fn():
+            raise ImportError(f"pyins: struct {struct} is {fn()} bytes in {lib_path} but "
+                              f"{ffi.sizeof(struct)} bytes in its header; {_REBUILD}.")
+    if has_hooks:
+        try:
+            lib.pyins_t_sin  # noqa: B018  (the library may be built without hooks)
+        except AttributeError:
+            has_hooks = False
+    return ffi, lib, lib_path, has_hooks
+
+
+ffi, lib, LIBRARY_PATH, HAS_TEST_HOOKS = _load()
+
+_PRIMITIVE = {"double": "<f8", "int64_t": "<i8", "int32_t": "<i4", "uint32_t": "<u4",
+              "uint64_t": "<u8", "uint8_t": "u1"}
+
+
+def _numpy_dtype(struct_name):
+    """The NumPy dtype with exactly the C struct's layout (names, offsets, size)."""
+    t = ffi.typeof(struct_name)
+    names, formats, offsets = [], [], []
+    for name, field in t.fields:
+        ft = field.type
+        if ft.kind == "array":
+            formats.append((np.dtype(_PRIMITIVE[ft.item.cname]), (ft.length,)))
+        else:
+            formats.append(np.dtype(_PRIMITIVE[ft.cname]))
+        names.append(name)
+        offsets.append(field.offset)
+    return np.dtype({"names": names, "formats": formats, "offsets": offsets,
+                     "itemsize": ffi.sizeof(t)})
+
+
+SAMPLE_DTYPE = _numpy_dtype("pyins_sample")
+OUTPUT_DTYPE = _numpy_dtype("pyins_output")
+CONFIG_FIELDS = tuple(name for name, _ in ffi.typeof("pyins_config").fields)
+
+VERTICAL_MODES = {"hold": 0, "free": 1}
+
+
+class CoreError(RuntimeError):
+    """A negative pyins_status returned by the C core."""
+
+    def __init__(self, code, where):
+        self.code = code
+        self.status_name = status_str(code).split(":")[0]
+        super().__init__(f"{where}: {status_str(code)}")
+
+
+class ConfigError(CoreError, ValueError):
+    """The core refused a configuration."""
+
+
+class SampleError(CoreError, ValueError):
+    """The core rejected a sample; ``index`` is its position, ``outputs`` the
+    records of the samples accepted before it (the state is after those)."""
+
+    def __init__(self, code, index, outputs):
+        self.index = index
+        self.outputs = outputs
+        super().__init__(code, f"sample {index} rejected ({index} samples before it were "
+                               f"accepted; the state is after them)")
+
+
+def status_str(code):
+    return ffi.string(lib.pyins_status_str(int(code))).decode()
+
+
+def _as_float_array(name, value, tail):
+    """Check one input array: float64, shape (N,) + tail, C-contiguous.
+
+    Plain Python sequences are converted; NumPy arrays must already be right
+    (cffi's from_buffer would reinterpret a wrong dtype silently).
+    """
+    if isinstance(value, np.ndarray):
+        a = value
+    else:
+        try:
+            a = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{name}: cannot be read as float64 numbers ({exc})") from None
+    if a.dtype != np.float64:
+        raise ValueError(f"{name}: dtype is {a.dtype}, expected float64 "
+                         f"(convert with .astype(numpy.float64))")
+    want = "(N,)" if not tail else f"(N, {', '.join(map(str, tail))})"
+    if a.ndim != 1 + len(tail) or a.shape[1:] != tail:
+        raise ValueError(f"{name}: shape is {a.shape}, expected {want}")
+    if not a.flags.c_contiguous:
+        raise ValueError(f"{name}: array is not C-contiguous (use numpy.ascontiguousarray)")
+    return a
+
+
+def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None):
+    """Pack per-field arrays into a SAMPLE_DTYPE array, checking each field.
+
+    dtheta_p_rad, dv_p_mps: (N, 3) float64 [rad], [m/s]; table_angle_rad:
+    (N,) float64 [rad] or None for a table fixed at 0.
+    """
+    dtheta = _as_float_array("dtheta_p_rad", dtheta_p_rad, (3,))
+    dv = _as_float_array("dv_p_mps", dv_p_mps, (3,))
+    n = dtheta.shape[0]
+    if dv.shape[0] != n:
+        raise ValueError(f"dv_p_mps: has {dv.shape[0]} rows but dtheta_p_rad has {n}")
+    samples = np.zeros(n, dtype=SAMPLE_DTYPE)
+    samples["dtheta_p_rad"] = dtheta
+    samples["dv_p_mps"] = dv
+    if table_angle_rad is not None:
+        table = _as_float_array("table_angle_rad", table_angle_rad, ())
+        if table.shape[0] != n:
+            raise ValueError(f"table_angle_rad: has {table.shape[0]} rows but dtheta_p_rad has {n}")
+        samples["table_angle_rad"] = table
+    return samples
+
+
+def _check_samples(samples):
+    if not isinstance(samples, np.ndarray) or samples.dtype != SAMPLE_DTYPE:
+        got = samples.dtype if isinstance(samples, np.ndarray) else type(samples).__name__
+        raise ValueError(f"samples: expected an array of pyins.native.SAMPLE_DTYPE, got {got} "
+                         f"(build one with pyins.native.make_samples)")
+    if samples.ndim != 1:
+        raise ValueError(f"samples: shape is {samples.shape}, expected (N,)")
+    if not samples.flags.c_contiguous:
+        raise ValueError("samples: array is not C-contiguous (use numpy.ascontiguousarray)")
+    return samples
+
+
+def make_config(config=None, **fields):
+    """A ``pyins_config *`` from a dict and/or keywords named like the C fields.
+
+    Starts from the defaults; unknown keys raise ValueError. ``vertical_mode``
+    takes 'hold', 'free' or the integer value.
+    """
+    merged = dict(config or {})
+    merged.update(fields)
+    cfg = ffi.new("pyins_config *")
+    lib.pyins_config_default(cfg)
+    for key, value in merged.items():
+        if key not in CONFIG_FIELDS:
+            raise ValueError(f"config: unknown key {key!r} (known: {', '.join(CONFIG_FIELDS)})")
+        if key == "vertical_mode" and isinstance(value, str):
+            if value not in VERTICAL_MODES:
+                raise ValueError(f"config: vertical_mode {value!r} is not one of {sorted(VERTICAL_MODES)}")
+            value = VERTICAL_MODES[value]
+        current = getattr(cfg, key)
+        if isinstance(current, ffi.CData):   # a fixed-length array field
+            arr = np.asarray(value, dtype=np.float64)
+            if arr.shape != (len(current),):
+                raise ValueError(f"config: {key} needs {len(current)} values, got shape {arr.shape}")
+            for i, v in enumerate(arr):
+                current[i] = float(v)
+        else:
+            try:
+                setattr(cfg, key, value)
+            except (TypeError, OverflowError) as exc:
+                raise ValueError(f"config: {key}={value!r}: {exc}") from None
+    return cfg
+
+
+class Firmware:
+    """One firmware instance in memory owned by this object.
+
+    >>> fw = Firmware(lat_rad=0.5, euler_b_rad=[0, 0, 1.0])
+    >>> out = fw.run(make_samples(dtheta, dv))      # doctest: +SKIP
+    """
+
+    def __init__(self, config=None, **fields):
+        cfg = make_config(config, **fields)
+        size = lib.pyins_core_size()
+        align = lib.pyins_core_align()
+        self._mem = ffi.new("unsigned char[]", size + align)
+        addr = int(ffi.cast("uintptr_t", self._mem))
+        self._core = ffi.cast("pyins_core *", self._mem + (-addr) % align)
+        status = lib.pyins_init(self._core, size, cfg)
+        if status != 0:
+            raise ConfigError(status, "pyins_init")
+        self.config = {name: (list(getattr(cfg, name)) if isinstance(getattr(cfg, name), ffi.CData)
+                              else getattr(cfg, name)) for name in CONFIG_FIELDS}
+        self._one_out = np.zeros(1, dtype=OUTPUT_DTYPE)
+        self._one_out_ptr = ffi.cast("pyins_output *", ffi.from_buffer(self._one_out))
+        self._one_sample = np.zeros(1, dtype=SAMPLE_DTYPE)
+        self._one_sample_ptr = ffi.cast("pyins_sample *", ffi.from_buffer(self._one_sample))
+
+    @property
+    def core(self):
+        """The raw ``pyins_core *`` (for benchmarks and tests)."""
+        return self._core
+
+    def output(self):
+        """The current state as one OUTPUT_DTYPE record."""
+        status = lib.pyins_get_output(self._core, self._one_out_ptr)
+        if status != 0:
+            raise CoreError(status, "pyins_get_output")
+        return self._one_out[0].copy()
+
+    def step(self, dtheta_p_rad, dv_p_mps, table_angle_rad=0.0):
+        """One tick; returns its OUTPUT_DTYPE record. SampleError if rejected."""
+        s = self._one_sample
+        s["dtheta_p_rad"][0] = _as_float_array("dtheta_p_rad", np.atleast_2d(dtheta_p_rad), (3,))[0]
+        s["dv_p_mps"][0] = _as_float_array("dv_p_mps", np.atleast_2d(dv_p_mps), (3,))[0]
+        s["table_angle_rad"][0] = float(table_angle_rad)
+        status = lib.pyins_step(self._core, self._one_sample_ptr, self._one_out_ptr)
+        if status != 0:
+            raise SampleError(status, 0, np.zeros(0, dtype=OUTPUT_DTYPE))
+        return self._one_out[0].copy()
+
+    def run(self, samples, outputs=None):
+        """Step through a SAMPLE_DTYPE array in one C call.
+
+        Returns the OUTPUT_DTYPE array (one record per sample); ``outputs``
+        may be a preallocated array to fill. SampleError at the first
+        rejected sample, carrying the records before it.
+        """
+        samples = _check_samples(samples)
+        n = samples.shape[0]
+        if outputs is None:
+            outputs = np.empty(n, dtype=OUTPUT_DTYPE)
+        elif (not isinstance(outputs, np.ndarray) or outputs.dtype != OUTPUT_DTYPE
+              or outputs.shape != (n,) or not outputs.flags.c_contiguous
+              or not outputs.flags.writeable):
+            raise ValueError("outputs: expected a writeable C-contiguous OUTPUT_DTYPE array "
+                             f"of shape ({n},)")
+        n_done = ffi.new("size_t *")
+        status = lib.pyins_run(self._core,
+                               ffi.cast("pyins_sample *", ffi.from_buffer(samples)), n,
+                               ffi.cast("pyins_output *", ffi.from_buffer(outputs, require_writable=True)),
+                               n_done)
+        if status != 0:
+            if status == lib.PYINS_E_SAMPLE_NONFINITE:
+                raise SampleError(status, int(n_done[0]), outputs[: n_done[0]].copy())
+            raise CoreError(status, "pyins_run")
+        return outputs
+
+
+def abi_version():
+    v = lib.pyins_abi_version()
+    return (v >> 16, v & 0xFFFF)
+
+
+def version():
+    return ffi.string(lib.pyins_version_string()).decode()

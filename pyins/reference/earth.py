@@ -1,0 +1,109 @@
+"""WGS-84 Earth model: radii of curvature, normal gravity, Earth and transport rates.
+
+Mirrors ``csrc/src/earth.{hpp,cpp}`` function for function, with the same names
+and the same order of operations, so the two can be read side by side. The
+simulator (``pyins.sim``) uses this same module, so an error-free simulation
+shows only algorithm error (DESIGN.md section 4).
+
+Navigation frame n is East-North-Up. All quantities SI: rad, m, s, m/s.
+
+References
+----------
+- NIMA TR8350.2 (2000), "Department of Defense World Geodetic System 1984",
+  eqs. 4-1 (Somigliana normal gravity on the ellipsoid) and 4-3 (its
+  second-order expansion in height).
+- Qin Yongyuan, "Inertial Navigation" (2nd ed., 2014), section 4.1: radii of
+  curvature R_M, R_N; the ENU transport rate; position rates.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+# --- WGS-84 defining and derived constants (earth.hpp: kA, kF, ...) ---------
+A = 6378137.0                      #: semi-major axis [m] (kA)
+F = 1.0 / 298.257223563            #: flattening [-] (kF)
+E2 = F * (2.0 - F)                 #: first eccentricity squared [-] (kE2)
+B = A * (1.0 - F)                  #: semi-minor axis [m] (kB)
+OMEGA_IE = 7.2921151467e-5         #: Earth rotation rate [rad/s] (kOmegaIe)
+GM = 3.986004418e14                #: gravitational constant [m^3/s^2] (kGM)
+GAMMA_E = 9.7803253359             #: normal gravity at the equator [m/s^2] (kGammaE)
+K_SOMIGLIANA = 0.00193185265241    #: Somigliana constant k [-] (kSomigliana)
+M_GRAV = OMEGA_IE * OMEGA_IE * A * A * B / GM  #: m = w^2 a^2 b / GM [-] (kMGrav)
+
+# --- named unit conversions (earth.hpp: kDegToRad, ...) ---------------------
+DEG_TO_RAD = np.pi / 180.0                 #: (kDegToRad)
+ARCSEC_TO_RAD = DEG_TO_RAD / 3600.0        #: (kArcsecToRad)
+ARCMIN_TO_RAD = DEG_TO_RAD / 60.0          #: (kArcminToRad)
+DPH_TO_RPS = DEG_TO_RAD / 3600.0           #: deg/h -> rad/s (kDphToRps)
+G0 = 9.80665                               #: standard gravity for ug/mg units [m/s^2] (kG0)
+UG_TO_MPS2 = 1e-6 * G0                     #: micro-g -> m/s^2 (kUgToMps2)
+NMI_TO_M = 1852.0                          #: nautical mile [m] (kNmiToM)
+
+
+def principal_radii(sin_lat):
+    """Meridian R_M and prime-vertical R_N radii of curvature [m].
+
+    Mirrors ``pyins::earth::principal_radii``. Qin (2014) eq. 4.1.7.
+    """
+    x = 1.0 - E2 * sin_lat * sin_lat
+    sqrt_x = np.sqrt(x)
+    rn = A / sqrt_x
+    rm = rn * (1.0 - E2) / x
+    return rm, rn
+
+
+def normal_gravity(sin_lat, height):
+    """Magnitude of normal gravity [m/s^2] at geodetic latitude and height.
+
+    Mirrors ``pyins::earth::normal_gravity``. TR8350.2 eqs. 4-1 and 4-3. It
+    includes the centrifugal part, and points along -Up of the ellipsoid normal.
+    """
+    s2 = sin_lat * sin_lat
+    gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
+    c1 = 2.0 / A * (1.0 + F + M_GRAV - 2.0 * F * s2)
+    c2 = 3.0 / (A * A)
+    return gamma0 * (1.0 - c1 * height + c2 * height * height)
+
+
+@dataclass
+class Earth:
+    """Earth quantities at one position and velocity (mirrors ``pyins::earth::Earth``)."""
+    sin_lat: float
+    cos_lat: float
+    tan_lat: float
+    rm_h: float          #: R_M + h [m]
+    rn_h: float          #: R_N + h [m]
+    omega_ie_n: np.ndarray   #: Earth rate in n [rad/s]
+    omega_en_n: np.ndarray   #: transport rate in n [rad/s]
+    omega_in_n: np.ndarray   #: omega_ie_n + omega_en_n [rad/s]
+    gravity_n: np.ndarray    #: normal gravity vector in n [m/s^2]
+
+
+def earth_at(sin_lat, cos_lat, height, vel_n):
+    """All Earth quantities the strapdown update needs at one point.
+
+    Mirrors ``pyins::earth::earth_at``. The caller passes sin and cos of the
+    latitude (the C++ core computes them with its own portable sin/cos).
+    Qin (2014) eqs. 4.1.9-4.1.11 (ENU): omega_ie^n = [0, W cosL, W sinL],
+    omega_en^n = [-vN/(RM+h), vE/(RN+h), vE tanL/(RN+h)].
+    """
+    rm, rn = principal_radii(sin_lat)
+    rm_h = rm + height
+    rn_h = rn + height
+    tan_lat = sin_lat / cos_lat
+    omega_ie_n = np.array([0.0, OMEGA_IE * cos_lat, OMEGA_IE * sin_lat])
+    omega_en_n = np.array([-vel_n[1] / rm_h, vel_n[0] / rn_h, vel_n[0] / rn_h * tan_lat])
+    omega_in_n = omega_ie_n + omega_en_n
+    gravity_n = np.array([0.0, 0.0, -normal_gravity(sin_lat, height)])
+    return Earth(sin_lat, cos_lat, tan_lat, rm_h, rn_h,
+                 omega_ie_n, omega_en_n, omega_in_n, gravity_n)
+
+
+def position_rate(earth, vel_n):
+    """Rates of latitude, longitude [rad/s] and height [m/s].
+
+    Mirrors ``pyins::earth::position_rate``. Qin (2014) eq. 4.1.12.
+    """
+    lat_dot = vel_n[1] / earth.rm_h
+    lon_dot = vel_n[0] / (earth.rn_h * earth.cos_lat)
+    return np.array([lat_dot, lon_dot, vel_n[2]])

@@ -1,0 +1,215 @@
+/* test_c_api.c: C99 test of the pyins C ABI contract: every status code,
+ * rejected samples leave the state unchanged, determinism, run == steps.
+ * Prints one line per check and a closing "N passed, M failed" line. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pyins_core.h"
+
+static int n_pass = 0;
+static int n_fail = 0;
+
+static void check(int ok, const char *what) {
+    if (ok) {
+        ++n_pass;
+    } else {
+        ++n_fail;
+        printf("FAIL: %s\n", what);
+    }
+}
+
+static void check_status(int got, int want, const char *what) {
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s: got %d (%s), want %d", what, got, pyins_status_str(got), want);
+    check(got == want, buf);
+}
+
+/* 16-byte aligned storage for one instance, plus room to misalign it. */
+static unsigned char *aligned_mem(size_t size, unsigned char **raw) {
+    *raw = (unsigned char *)malloc(size + 64);
+    uintptr_t p = (uintptr_t)(*raw);
+    p = (p + 63u) & ~(uintptr_t)63u;
+    return (unsigned char *)p;
+}
+
+static pyins_sample static_sample(void) {
+    /* Level, yaw 0, latitude 0: Earth rate along North (y), gravity up. */
+    pyins_sample s;
+    memset(&s, 0, sizeof s);
+    s.dtheta_p_rad[1] = 7.2921151467e-5 * 0.01;
+    s.dv_p_mps[2] = 9.7803253359 * 0.01;
+    s.table_angle_rad = 0.0;
+    return s;
+}
+
+int main(void) {
+    const size_t size = pyins_core_size();
+    const size_t align = pyins_core_align();
+    unsigned char *raw = NULL;
+    unsigned char *mem = aligned_mem(size, &raw);
+    pyins_config cfg;
+    pyins_output out;
+    int st;
+
+    check(pyins_abi_version() == ((PYINS_ABI_VERSION_MAJOR << 16) | PYINS_ABI_VERSION_MINOR),
+          "abi version matches header");
+    check(pyins_sizeof_config() == sizeof(pyins_config), "sizeof config");
+    check(pyins_sizeof_sample() == sizeof(pyins_sample), "sizeof sample");
+    check(pyins_sizeof_output() == sizeof(pyins_output), "sizeof output");
+    check(size > 0 && align >= 8 && (align & (align - 1)) == 0, "size and align sane");
+
+    /* Status strings: every code has its own, unknown codes are named so. */
+    {
+        const int codes[] = {PYINS_OK, PYINS_E_NULL, PYINS_E_MISALIGNED, PYINS_E_MEM_TOO_SMALL,
+                             PYINS_E_NOT_INIT, PYINS_E_SAMPLE_NONFINITE, PYINS_E_CONFIG_RATE,
+                             PYINS_E_CONFIG_LAT, PYINS_E_CONFIG_LON, PYINS_E_CONFIG_HEIGHT,
+                             PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE};
+        const size_t n = sizeof codes / sizeof codes[0];
+        size_t i, j;
+        int distinct = 1;
+        for (i = 0; i < n; ++i) {
+            for (j = i + 1; j < n; ++j) {
+                if (codes[i] == codes[j] || strcmp(pyins_status_str(codes[i]), pyins_status_str(codes[j])) == 0) {
+                    distinct = 0;
+                }
+            }
+            check(strstr(pyins_status_str(codes[i]), "unknown") == NULL, "status has a name");
+        }
+        check(distinct, "status codes and strings distinct");
+        check(strstr(pyins_status_str(-999), "unknown") != NULL, "unknown status named");
+        /* Pinned values: never renumbered. */
+        check(PYINS_E_NULL == -1 && PYINS_E_MISALIGNED == -2 && PYINS_E_MEM_TOO_SMALL == -3 &&
+              PYINS_E_NOT_INIT == -4 && PYINS_E_SAMPLE_NONFINITE == -5 && PYINS_E_CONFIG_RATE == -10 &&
+              PYINS_E_CONFIG_LAT == -11 && PYINS_E_CONFIG_MODE == -16, "pinned status values");
+    }
+
+    /* Config: defaults, zeroed == defaults, each bad field its own status. */
+    check_status(pyins_config_default(NULL), PYINS_E_NULL, "config_default(NULL)");
+    check_status(pyins_config_check(NULL), PYINS_E_NULL, "config_check(NULL)");
+    check_status(pyins_config_default(&cfg), PYINS_OK, "config_default");
+    check_status(pyins_config_check(&cfg), PYINS_OK, "default config valid");
+    {
+        pyins_config z;
+        memset(&z, 0, sizeof z);
+        check_status(pyins_config_check(&z), PYINS_OK, "zeroed config valid");
+    }
+#define BAD_CFG(field_stmt, want, what)              \
+    do {                                             \
+        pyins_config b;                              \
+        pyins_config_default(&b);                    \
+        field_stmt;                                  \
+        check_status(pyins_config_check(&b), want, what); \
+        memset(mem, 0xAB, size);                     \
+        check_status(pyins_init(mem, size, &b), want, "init " what); \
+        check_status(pyins_step((pyins_core *)mem, NULL, &out), PYINS_E_NOT_INIT, "no instance after failed init " what); \
+    } while (0)
+    BAD_CFG(b.tick_hz = -100, PYINS_E_CONFIG_RATE, "negative tick_hz");
+    BAD_CFG(b.tick_hz = 20000, PYINS_E_CONFIG_RATE, "tick_hz too high");
+    BAD_CFG(b.lat_rad = 1.6, PYINS_E_CONFIG_LAT, "latitude beyond 90 deg");
+    BAD_CFG(b.lat_rad = -1.6, PYINS_E_CONFIG_LAT, "latitude beyond -90 deg");
+    BAD_CFG(b.lat_rad = NAN, PYINS_E_CONFIG_LAT, "latitude NaN");
+    BAD_CFG(b.lon_rad = INFINITY, PYINS_E_CONFIG_LON, "longitude Inf");
+    BAD_CFG(b.height_m = 1e6, PYINS_E_CONFIG_HEIGHT, "height too high");
+    BAD_CFG(b.vel_n_mps[1] = NAN, PYINS_E_CONFIG_VEL, "velocity NaN");
+    BAD_CFG(b.euler_b_rad[2] = INFINITY, PYINS_E_CONFIG_ATT, "yaw Inf");
+    BAD_CFG(b.table_angle_rad = NAN, PYINS_E_CONFIG_ATT, "table angle NaN");
+    BAD_CFG(b.vertical_mode = 7, PYINS_E_CONFIG_MODE, "vertical mode unknown");
+
+    /* init: NULL, misaligned, too small. */
+    check_status(pyins_init(NULL, size, &cfg), PYINS_E_NULL, "init NULL mem");
+    check_status(pyins_init(mem, size, NULL), PYINS_E_NULL, "init NULL config");
+    check_status(pyins_init(mem + 1, size, &cfg), PYINS_E_MISALIGNED, "init misaligned");
+    check_status(pyins_init(mem, size - 1, &cfg), PYINS_E_MEM_TOO_SMALL, "init too small");
+    memset(mem, 0, size);
+    check_status(pyins_step((pyins_core *)mem, NULL, &out), PYINS_E_NOT_INIT, "step on zeroed memory");
+
+    /* A good instance. */
+    cfg.lat_rad = 0.0;
+    check_status(pyins_init(mem, size, &cfg), PYINS_OK, "init");
+    {
+        pyins_core *core = (pyins_core *)mem;
+        pyins_sample s = static_sample();
+        pyins_output before, after;
+        size_t n_done = 99;
+        check_status(pyins_step(NULL, &s, &out), PYINS_E_NULL, "step NULL core");
+        check_status(pyins_step((pyins_core *)(mem + 1), &s, &out), PYINS_E_MISALIGNED, "step misaligned core");
+        check_status(pyins_step(core, NULL, &out), PYINS_E_NULL, "step NULL sample");
+        check_status(pyins_step(core, &s, NULL), PYINS_E_NULL, "step NULL output");
+        check_status(pyins_get_output(core, NULL), PYINS_E_NULL, "get_output NULL");
+        check_status(pyins_get_output(NULL, &out), PYINS_E_NULL, "get_output NULL core");
+        check_status(pyins_run(core, NULL, 3, NULL, &n_done), PYINS_E_NULL, "run NULL samples");
+        check(n_done == 0, "run NULL samples: n_done 0");
+        check_status(pyins_run(core, NULL, 0, NULL, NULL), PYINS_OK, "run zero samples");
+
+        check_status(pyins_step(core, &s, &out), PYINS_OK, "step");
+        check(out.tick == 1 && out.mode == 1 && out.fault_flags == 0u, "tick, mode, faults after one step");
+        check_status(pyins_get_output(core, &before), PYINS_OK, "get_output");
+        /* Each non-finite field rejected; state untouched. */
+        {
+            int f;
+            for (f = 0; f < 7; ++f) {
+                pyins_sample bad = s;
+                double *fields[7] = {&bad.dtheta_p_rad[0], &bad.dtheta_p_rad[1], &bad.dtheta_p_rad[2],
+                                     &bad.dv_p_mps[0], &bad.dv_p_mps[1], &bad.dv_p_mps[2],
+                                     &bad.table_angle_rad};
+                *fields[f] = (f % 2) ? NAN : -INFINITY;
+                check_status(pyins_step(core, &bad, &out), PYINS_E_SAMPLE_NONFINITE, "non-finite sample rejected");
+                check(memcmp(&out, &before, sizeof out) == 0, "rejected sample: output shows unchanged state");
+            }
+        }
+        check_status(pyins_get_output(core, &after), PYINS_OK, "get_output after rejects");
+        check(memcmp(&before, &after, sizeof before) == 0, "rejected samples leave the state unchanged");
+
+        /* run stops at a bad sample and says where. */
+        {
+            pyins_sample batch[5];
+            pyins_output outs[5];
+            int i;
+            for (i = 0; i < 5; ++i) batch[i] = s;
+            batch[3].dv_p_mps[0] = NAN;
+            check_status(pyins_run(core, batch, 5, outs, &n_done), PYINS_E_SAMPLE_NONFINITE, "run with NaN at 3");
+            check(n_done == 3, "run: n_done == 3");
+            check(outs[2].tick == 4, "run: outputs before the bad sample written");
+        }
+    }
+
+    /* Determinism: two instances, same stream: identical bits; run == steps. */
+    {
+        enum { N = 1000 };
+        static pyins_sample samples[N];
+        static pyins_output a[N], b[N];
+        unsigned char *raw2 = NULL;
+        unsigned char *mem2 = aligned_mem(size, &raw2);
+        int i;
+        uint64_t x = 0x9E3779B97F4A7C15ull;
+        for (i = 0; i < N; ++i) {
+            int k;
+            samples[i] = static_sample();
+            for (k = 0; k < 3; ++k) {
+                x ^= x << 13; x ^= x >> 7; x ^= x << 17;
+                samples[i].dtheta_p_rad[k] += 1e-4 * ((double)(x >> 11) / 9007199254740992.0 - 0.5);
+                samples[i].dv_p_mps[k] += 1e-3 * ((double)(x >> 12) / 4503599627370496.0 - 0.5);
+            }
+            samples[i].table_angle_rad = 0.01 * i - 6.283185307179586 * (double)(int)(0.01 * i / 6.283185307179586);
+        }
+        pyins_config_default(&cfg);
+        cfg.lat_rad = 0.6;
+        cfg.euler_b_rad[2] = 1.0;
+        check_status(pyins_init(mem, size, &cfg), PYINS_OK, "init A");
+        check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "init B");
+        check_status(pyins_run((pyins_core *)mem, samples, N, a, NULL), PYINS_OK, "run A");
+        for (i = 0; i < N; ++i) {
+            if (pyins_step((pyins_core *)mem2, &samples[i], &b[i]) != PYINS_OK) break;
+        }
+        check(i == N, "step B all accepted");
+        check(memcmp(a, b, sizeof a) == 0, "N single steps == one N-sample run, bit for bit");
+        free(raw2);
+    }
+
+    free(raw);
+    printf("%d passed, %d failed\n", n_pass, n_fail);
+    return n_fail == 0 ? 0 : 1;
+}

@@ -1,0 +1,123 @@
+"""The Python side of the C ABI contract: layout, configuration errors,
+rejected samples, input checking, determinism."""
+import numpy as np
+import pytest
+
+from pyins import native
+from pyins.reference import earth
+
+
+def static_samples(n, lat=0.5):
+    """Error-free increments of a level IMU at yaw 0 on a static base."""
+    g = earth.normal_gravity(np.sin(lat), 0.0)
+    w = earth.OMEGA_IE
+    dth = np.tile([0.0, w * np.cos(lat) * 0.01, w * np.sin(lat) * 0.01], (n, 1))
+    dv = np.tile([0.0, 0.0, g * 0.01], (n, 1))
+    return native.make_samples(dth, dv)
+
+
+def test_layout_matches_library():
+    assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 56
+    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output()
+    assert native.abi_version() == native.EXPECTED_ABI
+    assert native.version() == "0.1.0"
+
+
+@pytest.mark.parametrize("field, value, status", [
+    ("lat_rad", np.deg2rad(91.0), "PYINS_E_CONFIG_LAT"),
+    ("lat_rad", float("nan"), "PYINS_E_CONFIG_LAT"),
+    ("tick_hz", -1, "PYINS_E_CONFIG_RATE"),
+    ("lon_rad", float("inf"), "PYINS_E_CONFIG_LON"),
+    ("height_m", 2e5, "PYINS_E_CONFIG_HEIGHT"),
+    ("vel_n_mps", [0.0, float("nan"), 0.0], "PYINS_E_CONFIG_VEL"),
+    ("euler_b_rad", [0.0, 0.0, float("inf")], "PYINS_E_CONFIG_ATT"),
+    ("vertical_mode", 5, "PYINS_E_CONFIG_MODE"),
+])
+def test_config_errors_are_distinct_and_named(field, value, status):
+    with pytest.raises(native.ConfigError) as info:
+        native.Firmware(**{field: value})
+    assert info.value.status_name == status
+    assert isinstance(info.value, ValueError)
+
+
+def test_config_key_errors():
+    with pytest.raises(ValueError, match="unknown key 'latitude'"):
+        native.Firmware(latitude=0.5)
+    with pytest.raises(ValueError, match="euler_b_rad needs 3 values"):
+        native.Firmware(euler_b_rad=[0.0, 1.0])
+    with pytest.raises(ValueError, match="vertical_mode 'up'"):
+        native.Firmware(vertical_mode="up")
+
+
+def test_rejected_sample_leaves_state_unchanged():
+    fw = native.Firmware(lat_rad=0.5)
+    samples = static_samples(10)
+    fw.run(samples[:5])
+    before = fw.output()
+    bad = samples[5:].copy()
+    bad["dv_p_mps"][2, 1] = np.nan
+    with pytest.raises(native.SampleError) as info:
+        fw.run(bad)
+    assert info.value.index == 2 and len(info.value.outputs) == 2
+    assert info.value.status_name == "PYINS_E_SAMPLE_NONFINITE"
+    # the two good samples were taken, the bad one not
+    after = fw.output()
+    assert after["tick"] == before["tick"] + 2
+    fw2 = native.Firmware(lat_rad=0.5)
+    fw2.run(samples[:7])
+    assert fw2.output().tobytes() == after.tobytes()
+    with pytest.raises(native.SampleError):
+        fw.step([np.inf, 0, 0], [0, 0, 0.1])
+    assert fw.output().tobytes() == after.tobytes()
+
+
+@pytest.mark.parametrize("field", ["dtheta_p_rad", "dv_p_mps", "table_angle_rad"])
+def test_wrong_arrays_raise_value_error_naming_the_field(field):
+    n = 8
+    good = {"dtheta_p_rad": np.zeros((n, 3)), "dv_p_mps": np.zeros((n, 3)),
+            "table_angle_rad": np.zeros(n)}
+    wrong_dtype = dict(good, **{field: good[field].astype(np.float32)})
+    with pytest.raises(ValueError, match=f"{field}: dtype is float32"):
+        native.make_samples(**wrong_dtype)
+    wrong_int = dict(good, **{field: good[field].astype(np.int32)})
+    with pytest.raises(ValueError, match=f"{field}: dtype is int32"):
+        native.make_samples(**wrong_int)
+    wrong_shape = dict(good, **{field: np.zeros((n, 4)) if good[field].ndim == 2 else np.zeros((n, 1))})
+    with pytest.raises(ValueError, match=f"{field}: shape"):
+        native.make_samples(**wrong_shape)
+    big = np.zeros((2 * n, 3)) if good[field].ndim == 2 else np.zeros(2 * n)
+    non_contig = dict(good, **{field: big[::2]})
+    with pytest.raises(ValueError, match=f"{field}: array is not C-contiguous"):
+        native.make_samples(**non_contig)
+
+
+def test_run_checks_the_sample_array():
+    fw = native.Firmware()
+    with pytest.raises(ValueError, match="samples: expected an array of pyins.native.SAMPLE_DTYPE"):
+        fw.run(np.zeros((4, 7)))
+    s = static_samples(8)
+    with pytest.raises(ValueError, match="samples: array is not C-contiguous"):
+        fw.run(s[::2])
+    with pytest.raises(ValueError, match="outputs:"):
+        fw.run(s, outputs=np.zeros(3, dtype=native.OUTPUT_DTYPE))
+    assert fw.output()["tick"] == 0      # nothing ran
+
+
+def test_determinism_and_batch_equals_steps():
+    rng = np.random.default_rng(7)
+    n = 3000
+    s = static_samples(n, lat=0.7)
+    s["dtheta_p_rad"] += 1e-5 * rng.standard_normal((n, 3))
+    s["dv_p_mps"] += 1e-3 * rng.standard_normal((n, 3))
+    s["table_angle_rad"] = np.mod(0.001 * np.arange(n), 2 * np.pi)
+    cfg = dict(lat_rad=0.7, euler_b_rad=[0.01, -0.02, 2.0], vel_n_mps=[1.0, 2.0, 0.0])
+    a = native.Firmware(cfg).run(s)
+    b = native.Firmware(cfg).run(s)
+    assert a.tobytes() == b.tobytes()
+    fw = native.Firmware(cfg)
+    steps = [fw.step(x["dtheta_p_rad"], x["dv_p_mps"], x["table_angle_rad"]) for x in s]
+    assert np.array(steps, dtype=native.OUTPUT_DTYPE).tobytes() == a.tobytes()
+    # chunked runs equal one run
+    fw = native.Firmware(cfg)
+    chunks = np.concatenate([fw.run(s[i:i + 700]) for i in range(0, n, 700)])
+    assert chunks.tobytes() == a.tobytes()

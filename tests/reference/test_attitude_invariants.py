@@ -1,0 +1,85 @@
+"""Invariants of the attitude module (NumPy reference, and the C++ core
+through its hooks): unit quaternions, proper orthonormal DCMs, and the round
+trips Euler <-> DCM <-> quaternion <-> rotation vector.
+
+Tolerances: 1e-15 to 2.2e-15 on unit quantities is 5 to 10 ulp, the rounding
+of a few chained products; round trips through atan2 near pitch = +-89 deg lose up to
+~1e-13 rad (the conditioning of roll/yaw there grows as 1/cos(pitch) ~ 57).
+"""
+import numpy as np
+from hypothesis import given
+from numpy.testing import assert_allclose
+
+import hooks
+from pyins.reference import attitude
+from strategies import euler_angles, quaternions, rotation_vectors
+
+ENGINES = {"reference": attitude, "core": hooks}
+
+
+def _proper_rotation(m):
+    # 2.2e-15 = 10 ulp at 1.0: each DCM element sums four products of
+    # quaternion components, and m m^T and det(m) add three more products,
+    # so a handful of roundings is expected; a non-rotation would be off by O(1).
+    assert_allclose(m @ m.T, np.eye(3), rtol=0, atol=2.2e-15)
+    assert abs(np.linalg.det(m) - 1.0) < 2.2e-15
+
+
+def _same_rotation(q1, q2, atol):
+    # q and -q are the same rotation
+    assert min(np.max(np.abs(q1 - q2)), np.max(np.abs(q1 + q2))) <= atol
+
+
+@given(v=rotation_vectors())
+def test_rotvec_quat_roundtrip(v):
+    for mod in ENGINES.values():
+        q = mod.rotvec_to_quat(v)
+        assert abs(np.linalg.norm(q) - 1.0) < 1e-15
+        _proper_rotation(mod.quat_to_mat(q))
+        back = mod.quat_to_rotvec(attitude.quat_normalize(q))
+        angle = np.linalg.norm(v)
+        if angle < np.pi - 1e-6:       # at pi, v and -v are the same rotation
+            assert_allclose(back, v, rtol=0, atol=1e-15 * max(1.0, angle))
+
+
+@given(q=quaternions())
+def test_quat_dcm_roundtrip(q):
+    for mod in ENGINES.values():
+        m = mod.quat_to_mat(q)
+        _proper_rotation(m)
+        _same_rotation(mod.mat_to_quat(m), q, 1e-15)
+
+
+@given(e=euler_angles())
+def test_euler_dcm_quat_roundtrip(e):
+    for mod in ENGINES.values():
+        m = mod.euler_to_mat(e)
+        _proper_rotation(m)
+        tol = 1e-15 / max(np.cos(e[0]), 1e-2) * 10
+        assert_allclose(mod.mat_to_euler(m), e, rtol=0, atol=tol)
+        q = mod.mat_to_quat(m)
+        assert_allclose(mod.mat_to_euler(mod.quat_to_mat(q)), e, rtol=0, atol=tol)
+
+
+@given(e=euler_angles())
+def test_euler_convention(e):
+    """C_b^n = Rz(yaw) Rx(pitch) Ry(roll); the bow of a level ship at yaw psi
+    points to [-sin psi, cos psi, 0] (yaw counter-clockwise from North)."""
+    pitch, roll, yaw = e
+    rx = np.array([[1, 0, 0], [0, np.cos(pitch), -np.sin(pitch)], [0, np.sin(pitch), np.cos(pitch)]])
+    ry = np.array([[np.cos(roll), 0, np.sin(roll)], [0, 1, 0], [-np.sin(roll), 0, np.cos(roll)]])
+    assert_allclose(attitude.euler_to_mat(e), attitude.rot_z(yaw) @ rx @ ry, rtol=0, atol=1e-15)
+    level = attitude.euler_to_mat([0.0, 0.0, yaw])
+    assert_allclose(level @ [0, 1, 0], [-np.sin(yaw), np.cos(yaw), 0], atol=1e-15)
+
+
+def test_heading_and_yaw():
+    deg = np.pi / 180
+    assert attitude.yaw_to_heading(0.0) == 0.0
+    assert np.signbit(attitude.yaw_to_heading(-0.0)) is np.False_ or attitude.yaw_to_heading(-0.0) == 0.0
+    assert not np.signbit(attitude.yaw_to_heading(0.0))
+    assert abs(attitude.yaw_to_heading(90 * deg) - 270 * deg) < 1e-15   # west
+    assert abs(attitude.yaw_to_heading(-90 * deg) - 90 * deg) < 1e-15   # east
+    assert abs(attitude.heading_to_yaw(90 * deg) + 90 * deg) < 1e-15
+    for h in np.linspace(0, 2 * np.pi, 37, endpoint=False):
+        assert abs(attitude.yaw_to_heading(attitude.heading_to_yaw(h)) - h) < 1e-14
