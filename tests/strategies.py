@@ -27,15 +27,15 @@ def vectors(scale):
 
 
 def rotation_vectors():
-    """Rotation vectors: zero, the small-angle series branch (|v| < 1e-3),
+    """Rotation vectors: zero, the small-angle series branch (|v|^2 < 1e-3),
     its boundary, ordinary angles, and angles near pi."""
     def near(angle):
         return unit_vectors().flatmap(
             lambda u: finite(-1e-9, 1e-9).map(lambda d: u * (angle + d)))
     return st.one_of(
         st.just(np.zeros(3)),
-        unit_vectors().flatmap(lambda u: finite(0.0, 2e-3).map(lambda a: u * a)),
-        near(1e-3),
+        unit_vectors().flatmap(lambda u: finite(0.0, 0.05).map(lambda a: u * a)),
+        near(np.sqrt(1e-3)),
         unit_vectors().flatmap(lambda u: finite(0.0, np.pi).map(lambda a: u * a)),
         near(np.pi - 1e-7),
         near(np.pi),

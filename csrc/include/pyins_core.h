@@ -46,6 +46,8 @@ enum pyins_status {
     PYINS_E_MEM_TOO_SMALL = -3,     /* mem_size < pyins_core_size() */
     PYINS_E_NOT_INIT = -4,          /* the memory does not hold an initialised instance */
     PYINS_E_SAMPLE_NONFINITE = -5,  /* a sample field is NaN or Inf; the sample was rejected */
+    PYINS_E_BAD_ARG = -6,           /* an argument is out of range (e.g. out_every == 0) */
+    PYINS_E_BUFFER_TOO_SMALL = -7,  /* an output buffer cannot hold the records asked for */
     PYINS_E_CONFIG_RATE = -10,      /* tick_hz out of range (must be 0 = default, or 1..10000) */
     PYINS_E_CONFIG_LAT = -11,       /* latitude not finite or beyond +-90 deg */
     PYINS_E_CONFIG_LON = -12,       /* longitude not finite or beyond +-360 deg */
@@ -146,6 +148,17 @@ int pyins_step(pyins_core *core, const pyins_sample *sample, pyins_output *out);
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_run(pyins_core *core, const pyins_sample *samples, size_t n,
               pyins_output *outputs, size_t *n_done);
+
+/* As pyins_run, but write an output record only after the steps whose tick
+ * (pyins_output.tick, counted since init) is a multiple of out_every: with
+ * out_every = 100 at 100 Hz, one record per second of ship time, in phase
+ * whatever the chunking. outputs must hold out_capacity records; at most
+ * n / out_every + 1 are written, and a smaller capacity is refused up front
+ * (nothing stepped). *n_out (if not NULL) receives the number written.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
+                        size_t out_every, pyins_output *outputs, size_t out_capacity,
+                        size_t *n_done, size_t *n_out);
 
 /* Write the current state as an output record (no step).
  * Returns PYINS_OK or a negative pyins_status. */

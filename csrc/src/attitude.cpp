@@ -41,7 +41,8 @@ Quat quat_normalize(const Quat& q) {
     if (q.w < 0.0) {
         n = -n;
     }
-    return Quat{q.w / n, q.x / n, q.y / n, q.z / n};
+    const double inv = 1.0 / n;
+    return Quat{q.w * inv, q.x * inv, q.y * inv, q.z * inv};
 }
 
 Mat3 quat_to_mat(const Quat& q) {
@@ -79,8 +80,8 @@ Quat rotvec_to_quat(const Vec3& v) {
     double c;
     double s;
     if (theta2 < kRotvecSeries2) {
-        c = 1.0 - theta2 / 8.0 + theta2 * theta2 / 384.0;
-        s = 0.5 - theta2 / 48.0 + theta2 * theta2 / 3840.0;
+        c = 1.0 - theta2 * (kCos2 - theta2 * (kCos4 - theta2 * kCos6));
+        s = 0.5 - theta2 * (kSin2 - theta2 * (kSin4 - theta2 * kSin6));
     } else {
         const double theta = pmath::sqrt(theta2);
         const double half = 0.5 * theta;

@@ -127,6 +127,51 @@ int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
     return PYINS_OK;
 }
 
+int pyins_run_decimated(pyins_core* core, const pyins_sample* samples, size_t n,
+                        size_t out_every, pyins_output* outputs, size_t out_capacity,
+                        size_t* n_done, size_t* n_out) {
+    if (n_done != nullptr) {
+        *n_done = 0;
+    }
+    if (n_out != nullptr) {
+        *n_out = 0;
+    }
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if ((samples == nullptr && n > 0u) || (outputs == nullptr && out_capacity > 0u)) {
+        return PYINS_E_NULL;
+    }
+    if (out_every == 0u) {
+        return PYINS_E_BAD_ARG;
+    }
+    if (out_capacity < n / out_every + 1u) {
+        return PYINS_E_BUFFER_TOO_SMALL;
+    }
+    Firmware* fw = const_cast<Firmware*>(cfw);
+    const uint64_t every = static_cast<uint64_t>(out_every);
+    size_t written = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const int s = fw->step(samples[i], nullptr);
+        if (s != PYINS_OK) {
+            return s;
+        }
+        if (n_done != nullptr) {
+            *n_done = i + 1u;
+        }
+        if (static_cast<uint64_t>(fw->tick()) % every == 0u) {
+            fw->output(&outputs[written]);
+            written = written + 1u;
+            if (n_out != nullptr) {
+                *n_out = written;
+            }
+        }
+    }
+    return PYINS_OK;
+}
+
 int pyins_get_output(const pyins_core* core, pyins_output* out) {
     const Firmware* fw = nullptr;
     const int status = checked(core, &fw);
@@ -148,6 +193,8 @@ const char* pyins_status_str(int status) {
         case PYINS_E_MEM_TOO_SMALL: return "PYINS_E_MEM_TOO_SMALL: memory is smaller than pyins_core_size()";
         case PYINS_E_NOT_INIT: return "PYINS_E_NOT_INIT: the memory does not hold an initialised instance";
         case PYINS_E_SAMPLE_NONFINITE: return "PYINS_E_SAMPLE_NONFINITE: a sample field is NaN or Inf; sample rejected, state unchanged";
+        case PYINS_E_BAD_ARG: return "PYINS_E_BAD_ARG: an argument is out of range (e.g. out_every == 0)";
+        case PYINS_E_BUFFER_TOO_SMALL: return "PYINS_E_BUFFER_TOO_SMALL: the output buffer cannot hold the records asked for";
         case PYINS_E_CONFIG_RATE: return "PYINS_E_CONFIG_RATE: tick_hz must be 0 (default 100) or 1..10000";
         case PYINS_E_CONFIG_LAT: return "PYINS_E_CONFIG_LAT: latitude must be finite and within +-89.9 deg (ENU is singular at the poles)";
         case PYINS_E_CONFIG_LON: return "PYINS_E_CONFIG_LON: longitude must be finite and within +-720 deg";

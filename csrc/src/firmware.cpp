@@ -20,6 +20,9 @@ bool finite3(const double v[3]) {
 
 /// Angle in [0, 2 pi). std::floor is exact, so this is bit-portable.
 double wrap_two_pi(double a) {
+    if (a >= 0.0 && a < kTwoPi) {
+        return a;
+    }
     double w = a - kTwoPi * std::floor(a / kTwoPi);
     if (w >= kTwoPi) {
         w = 0.0;
@@ -79,6 +82,7 @@ void Firmware::init(const pyins_config& cfg) {
     tick_ = 0;
     table_angle_ = cfg.table_angle_rad;
     encoder_ = wrap_two_pi(cfg.table_angle_rad);
+    pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
 
     // The IMU frame at t0: C_p^n = C_b^n C_p^b = C_b^n Rz(alpha).
     const Vec3 euler_b(cfg.euler_b_rad[0], cfg.euler_b_rad[1], cfg.euler_b_rad[2]);
@@ -112,7 +116,10 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     // Unwrap the encoder: the table turns far less than pi per tick.
     const double encoder = wrap_two_pi(sample.table_angle_rad);
     table_angle_ = table_angle_ + wrap_pi(encoder - encoder_);
-    encoder_ = encoder;
+    if (encoder != encoder_) {  // the table moved: refresh the cached half-angle
+        encoder_ = encoder;
+        pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
+    }
     tick_ = tick_ + 1;
     if (out != nullptr) {
         output(out);
@@ -134,10 +141,7 @@ void Firmware::output(pyins_output* out) const {
 
     // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
     // measured (encoder) angle: q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)].
-    double s;
-    double c;
-    pmath::sincos(0.5 * encoder_, &s, &c);
-    const Quat q_pb{c, 0.0, 0.0, -s};
+    const Quat q_pb{enc_cos_half_, 0.0, 0.0, -enc_sin_half_};
     const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(nav.quat_np, q_pb));
     const Vec3 euler_b = attitude::quat_to_euler(q_nb);
     out->quat_nb[0] = q_nb.w;

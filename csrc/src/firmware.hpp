@@ -42,6 +42,7 @@ class Firmware {
     void output(pyins_output* out) const;
 
     uint32_t magic() const { return magic_; }
+    int64_t tick() const { return tick_; }
 
   private:
     uint32_t magic_;
@@ -51,6 +52,8 @@ class Firmware {
     strapdown::Strapdown sd_;
     double table_angle_;          ///< unwrapped turntable angle alpha [rad]
     double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]
+    double enc_sin_half_;         ///< sin(encoder_ / 2), kept with encoder_
+    double enc_cos_half_;         ///< cos(encoder_ / 2)
 };
 
 }  // namespace pyins::firmware

@@ -12,9 +12,9 @@ using attitude::cross;
 Compensated compensate(const Vec3& dtheta, const Vec3& dv,
                        const Vec3& prev_dtheta, const Vec3& prev_dv) {
     Compensated c;
-    c.phi = dtheta + cross(prev_dtheta, dtheta) / 12.0;
+    c.phi = dtheta + kOneTwelfth * cross(prev_dtheta, dtheta);
     const Vec3 dv_rot = 0.5 * cross(dtheta, dv);
-    const Vec3 dv_scul = (cross(prev_dtheta, dv) + cross(prev_dv, dtheta)) / 12.0;
+    const Vec3 dv_scul = kOneTwelfth * (cross(prev_dtheta, dv) + cross(prev_dv, dtheta));
     c.dv_p = dv + dv_rot + dv_scul;
     return c;
 }

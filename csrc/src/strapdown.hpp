@@ -42,6 +42,9 @@ struct Strapdown {
     double ref_height;    ///< height held in kHold mode [m]
 };
 
+/// 1/12, the two-sample coning and sculling coefficient (Savage 1998).
+inline constexpr double kOneTwelfth = 1.0 / 12.0;
+
 /// Rotation vector and velocity increment, compensated.
 struct Compensated {
     Vec3 phi;    ///< rotation of p over the tick [rad]

@@ -17,6 +17,8 @@ PYINS_E_MISALIGNED = -2
 PYINS_E_MEM_TOO_SMALL = -3
 PYINS_E_NOT_INIT = -4
 PYINS_E_SAMPLE_NONFINITE = -5
+PYINS_E_BAD_ARG = -6
+PYINS_E_BUFFER_TOO_SMALL = -7
 PYINS_E_CONFIG_RATE = -10
 PYINS_E_CONFIG_LAT = -11
 PYINS_E_CONFIG_LON = -12
@@ -76,6 +78,8 @@ def config_check(cfg):
 
 def wrap_two_pi(a):
     """Angle in [0, 2 pi)."""
+    if 0.0 <= a < TWO_PI:
+        return a
     w = a - TWO_PI * math.floor(a / TWO_PI)
     if w >= TWO_PI:
         w = 0.0
@@ -114,6 +118,8 @@ class Firmware:
         self.tick = 0
         self.table_angle = cfg["table_angle_rad"]
         self.encoder = wrap_two_pi(cfg["table_angle_rad"])
+        self.enc_sin_half = math.sin(0.5 * self.encoder)
+        self.enc_cos_half = math.cos(0.5 * self.encoder)
         euler_b = np.array(cfg["euler_b_rad"], dtype=float)
         mat_np = attitude.euler_to_mat(euler_b) @ attitude.rot_z(self.encoder)
         lon = cfg["lon_rad"]
@@ -132,15 +138,16 @@ class Firmware:
                          np.asarray(dv_p, dtype=float), self.dt)
         encoder = wrap_two_pi(table_angle_rad)
         self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
-        self.encoder = encoder
+        if encoder != self.encoder:   # the table moved: refresh the cached half-angle
+            self.encoder = encoder
+            self.enc_sin_half = math.sin(0.5 * self.encoder)
+            self.enc_cos_half = math.cos(0.5 * self.encoder)
         self.tick = self.tick + 1
         return PYINS_OK, self.output()
 
     def output(self):
         nav = self.sd.nav
-        s = math.sin(0.5 * self.encoder)
-        c = math.cos(0.5 * self.encoder)
-        q_pb = np.array([c, 0.0, 0.0, -s])
+        q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
         q_nb = attitude.quat_normalize(attitude.quat_mul(nav.quat_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
         return {

@@ -14,6 +14,7 @@ from .attitude import cross
 
 VERTICAL_HOLD = 0  #: Vertical::kHold
 VERTICAL_FREE = 1  #: Vertical::kFree
+ONE_TWELFTH = 1.0 / 12.0  #: kOneTwelfth, the two-sample coning/sculling coefficient
 
 
 @dataclass
@@ -41,9 +42,9 @@ def compensate(dtheta, dv, prev_dtheta, prev_dv):
 
     Returns ``(phi, dv_p)``; see ``pyins::strapdown::compensate``.
     """
-    phi = dtheta + cross(prev_dtheta, dtheta) / 12.0
+    phi = dtheta + ONE_TWELFTH * cross(prev_dtheta, dtheta)
     dv_rot = 0.5 * cross(dtheta, dv)
-    dv_scul = (cross(prev_dtheta, dv) + cross(prev_dv, dtheta)) / 12.0
+    dv_scul = ONE_TWELFTH * (cross(prev_dtheta, dv) + cross(prev_dv, dtheta))
     dv_p = dv + dv_rot + dv_scul
     return phi, dv_p
 

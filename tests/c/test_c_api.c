@@ -64,7 +64,8 @@ int main(void) {
     /* Status strings: every code has its own, unknown codes are named so. */
     {
         const int codes[] = {PYINS_OK, PYINS_E_NULL, PYINS_E_MISALIGNED, PYINS_E_MEM_TOO_SMALL,
-                             PYINS_E_NOT_INIT, PYINS_E_SAMPLE_NONFINITE, PYINS_E_CONFIG_RATE,
+                             PYINS_E_NOT_INIT, PYINS_E_SAMPLE_NONFINITE, PYINS_E_BAD_ARG,
+                             PYINS_E_BUFFER_TOO_SMALL, PYINS_E_CONFIG_RATE,
                              PYINS_E_CONFIG_LAT, PYINS_E_CONFIG_LON, PYINS_E_CONFIG_HEIGHT,
                              PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE};
         const size_t n = sizeof codes / sizeof codes[0];
@@ -206,6 +207,38 @@ int main(void) {
         }
         check(i == N, "step B all accepted");
         check(memcmp(a, b, sizeof a) == 0, "N single steps == one N-sample run, bit for bit");
+
+        /* Decimated runs: records at ticks that are multiples of out_every,
+         * equal to the full run's records, whatever the chunking. */
+        {
+            static pyins_output d[N / 7 + 2];
+            size_t nd = 0, no = 0, total = 0, start = 0;
+            const size_t chunks[] = {1, 13, 250, 736};
+            size_t c;
+            int same = 1;
+            check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "init C");
+            check_status(pyins_run_decimated((pyins_core *)mem2, samples, 10, 0, d, 10, &nd, &no),
+                         PYINS_E_BAD_ARG, "run_decimated out_every 0");
+            check_status(pyins_run_decimated((pyins_core *)mem2, samples, 100, 7, d, 14, &nd, &no),
+                         PYINS_E_BUFFER_TOO_SMALL, "run_decimated capacity too small");
+            check(nd == 0 && no == 0, "refused run_decimated stepped nothing");
+            check_status(pyins_run_decimated((pyins_core *)mem2, NULL, 5, 7, d, 14, &nd, &no),
+                         PYINS_E_NULL, "run_decimated NULL samples");
+            for (c = 0; c < 4; ++c) {
+                check_status(pyins_run_decimated((pyins_core *)mem2, samples + start, chunks[c], 7,
+                                                 d + total, N / 7 + 2 - total, &nd, &no),
+                             PYINS_OK, "run_decimated chunk");
+                start += chunks[c];
+                total += no;
+            }
+            check(start == N && total == N / 7, "decimated record count");
+            for (c = 0; c < total; ++c) {
+                if (memcmp(&d[c], &a[7 * (c + 1) - 1], sizeof d[c]) != 0 || d[c].tick != (int64_t)(7 * (c + 1))) {
+                    same = 0;
+                }
+            }
+            check(same, "decimated records equal the full run's at ticks 7, 14, ...");
+        }
         free(raw2);
     }
 

@@ -121,3 +121,15 @@ def test_determinism_and_batch_equals_steps():
     fw = native.Firmware(cfg)
     chunks = np.concatenate([fw.run(s[i:i + 700]) for i in range(0, n, 700)])
     assert chunks.tobytes() == a.tobytes()
+
+
+def test_decimated_run_matches_full_run_in_phase():
+    s = static_samples(1050, lat=0.3)
+    full = native.Firmware(lat_rad=0.3).run(s)
+    fw = native.Firmware(lat_rad=0.3)
+    parts = [fw.run(s[a:b], every=100) for a, b in ((0, 37), (37, 620), (620, 1050))]
+    dec = np.concatenate(parts)
+    assert list(dec["tick"]) == list(range(100, 1001, 100))
+    assert dec.tobytes() == full[99:1000:100].tobytes()
+    with pytest.raises(ValueError, match="every: must be a positive"):
+        fw.run(s, every=0)

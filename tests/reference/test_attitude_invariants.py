@@ -8,11 +8,12 @@ of a few chained products; round trips through atan2 near pitch = +-89 deg lose 
 """
 import numpy as np
 from hypothesis import given
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import hooks
 from pyins.reference import attitude
-from strategies import euler_angles, quaternions, rotation_vectors
+from strategies import euler_angles, quaternions, rotation_vectors, unit_vectors
 
 ENGINES = {"reference": attitude, "core": hooks}
 
@@ -83,3 +84,13 @@ def test_heading_and_yaw():
     assert abs(attitude.heading_to_yaw(90 * deg) + 90 * deg) < 1e-15
     for h in np.linspace(0, 2 * np.pi, 37, endpoint=False):
         assert abs(attitude.yaw_to_heading(attitude.heading_to_yaw(h)) - h) < 1e-14
+
+
+@given(angle=st.floats(1e-4, np.sqrt(attitude.ROTVEC_SERIES2)), u=unit_vectors())
+def test_rotvec_series_branch_equals_closed_form(angle, u):
+    """The Taylor branch must agree with cos/sin to 1 ulp (2.2e-16) where it
+    is used, or the switch would put a step into the attitude."""
+    v = u * angle
+    half = 0.5 * angle
+    closed = np.concatenate([[np.cos(half)], np.sin(half) / angle * v])
+    assert_allclose(attitude.rotvec_to_quat(v), closed, rtol=0, atol=2.2e-16)

@@ -1,0 +1,34 @@
+"""The plant: ship and turntable motion, exact IMU increments, sensor errors, files.
+
+- `pyins.sim.motion`: analytic motion profiles (`Static`, `Swing` and the
+  seed 000 sea states, `HeadingSwing` of seed 002, `Manoeuvre`) and turntable
+  profiles (`Fixed`, `ConstantRate`).
+- `pyins.sim.imu`: exact per-tick increments by Gauss-Legendre quadrature of
+  the body rate and specific force (`exact_increments`), the true state at the
+  sample instants (`truth`), and a chunked run generator (`generate`).
+- `pyins.sim.sensors`: bias, scale factor, misalignment, random walk and
+  quantisation (`SensorErrors`, `SensorModel`, `preset`).
+- `pyins.sim.io`: .npz and CSV sample files.
+
+Frames and units as in ``pyins`` (DESIGN.md section 2): n = ENU, b = x
+starboard / y bow / z up, p = IMU on the turntable with C_p^b = Rz(alpha);
+Euler [pitch, roll, yaw], C_b^n = Rz(yaw) Rx(pitch) Ry(roll); SI inside. The
+Earth model is ``pyins.reference.earth``, the same as the firmware's.
+"""
+from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, euler_to_quat,
+                           exact_increments, generate, truth)
+from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
+                          save_npz)
+from pyins.sim.motion import (SEA_STATES, ConstantRate, Fixed, HeadingSwing, Manoeuvre, Motion,
+                              MotionState, Segment, Static, Swing, TableMotion, default_segments,
+                              sea_state)
+from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
+
+__all__ = [
+    "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
+    "exact_increments", "generate", "truth",
+    "CSV_COLUMNS", "CSV_HEADER", "ImuData", "load_csv", "load_npz", "save_csv", "save_npz",
+    "SEA_STATES", "ConstantRate", "Fixed", "HeadingSwing", "Manoeuvre", "Motion",
+    "MotionState", "Segment", "Static", "Swing", "TableMotion", "default_segments", "sea_state",
+    "PRESETS", "SensorErrors", "SensorModel", "preset",
+]
