@@ -97,10 +97,11 @@ def mat_orthonormalize(m):
     return call("mat_orthonormalize", m, n_out=9).reshape(3, 3)
 
 
-def compensate(dtheta, dv, prev_dtheta, prev_dv):
-    keep = [_in(a) for a in (dtheta, dv, prev_dtheta, prev_dv)]
+def compensate(dtheta, dv, h):
+    """h: a reference strapdown.History."""
+    keep = [_in(a) for a in (dtheta, dv, h.dtheta1, h.dv1, h.dtheta2, h.dv2)]
     phi, dvp = _d(3), _d(3)
-    lib.pyins_t_compensate(*[k[0] for k in keep], phi, dvp)
+    lib.pyins_t_compensate(*[k[0] for k in keep], h.count, phi, dvp)
     return _out(phi, 3), _out(dvp, 3)
 
 
@@ -110,12 +111,14 @@ def strapdown_state(s):
     c.lat, c.lon, c.height = s.nav.lat, s.nav.lon, s.nav.height
     for i in range(3):
         c.vel_n[i] = s.nav.vel_n[i]
-        c.prev_dtheta_p[i] = s.prev_dtheta_p[i]
-        c.prev_dv_p[i] = s.prev_dv_p[i]
+        c.dtheta1[i] = s.hist.dtheta1[i]
+        c.dv1[i] = s.hist.dv1[i]
+        c.dtheta2[i] = s.hist.dtheta2[i]
+        c.dv2[i] = s.hist.dv2[i]
         c.prev_dvel_n[i] = s.prev_dvel_n[i]
     for i in range(4):
         c.quat_np[i] = s.nav.quat_np[i]
-    c.has_prev = 1 if s.has_prev else 0
+    c.hist_count = s.hist.count
     c.vertical = s.vertical
     c.ref_height = s.ref_height
     return c

@@ -31,8 +31,8 @@ typedef struct pyins_t_strapdown {
     double lat, lon, height;
     double vel_n[3];
     double quat_np[4];
-    double prev_dtheta_p[3], prev_dv_p[3], prev_dvel_n[3];
-    int32_t has_prev;
+    double dtheta1[3], dv1[3], dtheta2[3], dv2[3], prev_dvel_n[3];
+    int32_t hist_count;
     int32_t vertical;
     double ref_height;
 } pyins_t_strapdown;
@@ -69,7 +69,8 @@ double pyins_t_heading_to_yaw(double heading);
 
 /* strapdown */
 void pyins_t_compensate(const double dtheta[3], const double dv[3],
-                        const double prev_dtheta[3], const double prev_dv[3],
+                        const double dtheta1[3], const double dv1[3],
+                        const double dtheta2[3], const double dv2[3], int32_t count,
                         double phi[3], double dv_p[3]);
 void pyins_t_strapdown_update(pyins_t_strapdown *s, const double dtheta_p[3],
                               const double dv_p[3], double dt);

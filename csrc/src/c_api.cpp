@@ -315,10 +315,16 @@ void pyins_t_mat_orthonormalize(const double m[9], double out[9]) {
 double pyins_t_yaw_to_heading(double yaw) { return pyins::attitude::yaw_to_heading(yaw); }
 double pyins_t_heading_to_yaw(double heading) { return pyins::attitude::heading_to_yaw(heading); }
 
-void pyins_t_compensate(const double dtheta[3], const double dv[3], const double prev_dtheta[3],
-                        const double prev_dv[3], double phi[3], double dv_p[3]) {
-    const pyins::strapdown::Compensated c =
-        pyins::strapdown::compensate(v3(dtheta), v3(dv), v3(prev_dtheta), v3(prev_dv));
+void pyins_t_compensate(const double dtheta[3], const double dv[3], const double dtheta1[3],
+                        const double dv1[3], const double dtheta2[3], const double dv2[3],
+                        int32_t count, double phi[3], double dv_p[3]) {
+    pyins::strapdown::History h;
+    h.dtheta1 = v3(dtheta1);
+    h.dv1 = v3(dv1);
+    h.dtheta2 = v3(dtheta2);
+    h.dv2 = v3(dv2);
+    h.count = count;
+    const pyins::strapdown::Compensated c = pyins::strapdown::compensate(v3(dtheta), v3(dv), h);
     put3(c.phi, phi);
     put3(c.dv_p, dv_p);
 }
@@ -331,10 +337,12 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     sd.nav.height = s->height;
     sd.nav.vel_n = v3(s->vel_n);
     sd.nav.quat_np = q4(s->quat_np);
-    sd.prev_dtheta_p = v3(s->prev_dtheta_p);
-    sd.prev_dv_p = v3(s->prev_dv_p);
+    sd.hist.dtheta1 = v3(s->dtheta1);
+    sd.hist.dv1 = v3(s->dv1);
+    sd.hist.dtheta2 = v3(s->dtheta2);
+    sd.hist.dv2 = v3(s->dv2);
+    sd.hist.count = s->hist_count;
     sd.prev_dvel_n = v3(s->prev_dvel_n);
-    sd.has_prev = s->has_prev != 0;
     sd.vertical = s->vertical == 1 ? pyins::strapdown::Vertical::kFree
                                    : pyins::strapdown::Vertical::kHold;
     sd.ref_height = s->ref_height;
@@ -344,10 +352,12 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     s->height = sd.nav.height;
     put3(sd.nav.vel_n, s->vel_n);
     put4(sd.nav.quat_np, s->quat_np);
-    put3(sd.prev_dtheta_p, s->prev_dtheta_p);
-    put3(sd.prev_dv_p, s->prev_dv_p);
+    put3(sd.hist.dtheta1, s->dtheta1);
+    put3(sd.hist.dv1, s->dv1);
+    put3(sd.hist.dtheta2, s->dtheta2);
+    put3(sd.hist.dv2, s->dv2);
+    s->hist_count = sd.hist.count;
     put3(sd.prev_dvel_n, s->prev_dvel_n);
-    s->has_prev = sd.has_prev ? 1 : 0;
 }
 
 }  // extern "C"

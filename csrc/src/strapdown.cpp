@@ -9,23 +9,35 @@ namespace pyins::strapdown {
 
 using attitude::cross;
 
-Compensated compensate(const Vec3& dtheta, const Vec3& dv,
-                       const Vec3& prev_dtheta, const Vec3& prev_dv) {
+Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h) {
     Compensated c;
-    c.phi = dtheta + kOneTwelfth * cross(prev_dtheta, dtheta);
-    const Vec3 dv_rot = 0.5 * cross(dtheta, dv);
-    const Vec3 dv_scul = kOneTwelfth * (cross(prev_dtheta, dv) + cross(prev_dv, dtheta));
-    c.dv_p = dv + dv_rot + dv_scul;
+    Vec3 cone = Vec3::Zero();
+    Vec3 scul = Vec3::Zero();
+    if (h.count >= 2) {
+        cone = kC3Near * cross(h.dtheta1, dtheta) + kC3Far * cross(h.dtheta2, dtheta) +
+               kC3Past * cross(h.dtheta2, h.dtheta1);
+        scul = kC3Near * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta)) +
+               kC3Far * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta)) +
+               kC3Past * (cross(h.dtheta2, h.dv1) + cross(h.dv2, h.dtheta1));
+    } else if (h.count == 1) {
+        cone = kOneTwelfth * cross(h.dtheta1, dtheta);
+        scul = kOneTwelfth * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta));
+    }
+    c.phi = dtheta + cone;
+    const Vec3 dv_rot = 0.5 * cross(dtheta, dv) + kOneSixth * cross(dtheta, cross(dtheta, dv));
+    c.dv_p = dv + dv_rot + scul;
     return c;
 }
 
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     Strapdown s;
     s.nav = nav;
-    s.prev_dtheta_p = Vec3::Zero();
-    s.prev_dv_p = Vec3::Zero();
+    s.hist.dtheta1 = Vec3::Zero();
+    s.hist.dv1 = Vec3::Zero();
+    s.hist.dtheta2 = Vec3::Zero();
+    s.hist.dv2 = Vec3::Zero();
+    s.hist.count = 0;
     s.prev_dvel_n = Vec3::Zero();
-    s.has_prev = false;
     s.vertical = vertical;
     s.ref_height = nav.height;
     if (vertical == Vertical::kHold) {
@@ -35,12 +47,8 @@ Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
 }
 
 void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
-    // 1. Coning, sculling and rotation compensation. Before the first tick
-    //    there is no previous sample: using the current one makes both
-    //    corrections exactly zero (constant-rate assumption).
-    const Vec3 prev_dtheta = s.has_prev ? s.prev_dtheta_p : dtheta_p;
-    const Vec3 prev_dv = s.has_prev ? s.prev_dv_p : dv_p;
-    const Compensated c = compensate(dtheta_p, dv_p, prev_dtheta, prev_dv);
+    // 1. Coning, sculling and rotation compensation (strapdown.hpp).
+    const Compensated c = compensate(dtheta_p, dv_p, s.hist);
 
     // 2. Earth quantities at the start position with the velocity
     //    extrapolated to mid-tick (Yan 2019 sec. 4.1.4). The position is not
@@ -90,9 +98,13 @@ void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     // 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n;
     s.nav.vel_n = vel_new;
-    s.prev_dtheta_p = dtheta_p;
-    s.prev_dv_p = dv_p;
-    s.has_prev = true;
+    s.hist.dtheta2 = s.hist.dtheta1;
+    s.hist.dv2 = s.hist.dv1;
+    s.hist.dtheta1 = dtheta_p;
+    s.hist.dv1 = dv_p;
+    if (s.hist.count < 2) {
+        s.hist.count = s.hist.count + 1;
+    }
 }
 
 }  // namespace pyins::strapdown

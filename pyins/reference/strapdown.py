@@ -2,8 +2,8 @@
 
 Mirrors ``csrc/src/strapdown.{hpp,cpp}``: same names, same order of
 operations. See the C++ header for the algorithm and its sources (Savage
-1998 two-sample coning/sculling; Yan Gongmin 2019 sec. 4.1 velocity and
-attitude updates).
+1998; Yan Gongmin 2019 sec. 4.1) and for the three-sample coning/sculling
+coefficients (derived by ``tools/derive_coning.py``).
 """
 from dataclasses import dataclass, field
 
@@ -14,7 +14,16 @@ from .attitude import cross
 
 VERTICAL_HOLD = 0  #: Vertical::kHold
 VERTICAL_FREE = 1  #: Vertical::kFree
-ONE_TWELFTH = 1.0 / 12.0  #: kOneTwelfth, the two-sample coning/sculling coefficient
+
+ONE_TWELFTH = 1.0 / 12.0     #: kOneTwelfth (two-sample coefficient)
+C3_NEAR = 121.0 / 720.0      #: kC3Near, (k-1) x (k)
+C3_FAR = -31.0 / 720.0       #: kC3Far, (k-2) x (k)
+C3_PAST = 1.0 / 720.0        #: kC3Past, (k-2) x (k-1)
+ONE_SIXTH = 1.0 / 6.0        #: kOneSixth
+
+
+def _zeros():
+    return np.zeros(3)
 
 
 @dataclass
@@ -27,25 +36,43 @@ class NavState:
 
 
 @dataclass
+class History:
+    """Increments of the ticks before the current one (mirrors History)."""
+    dtheta1: np.ndarray = field(default_factory=_zeros)   #: tick k-1 [rad]
+    dv1: np.ndarray = field(default_factory=_zeros)       #: tick k-1 [m/s]
+    dtheta2: np.ndarray = field(default_factory=_zeros)   #: tick k-2 [rad]
+    dv2: np.ndarray = field(default_factory=_zeros)       #: tick k-2 [m/s]
+    count: int = 0                                        #: valid entries: 0, 1, 2
+
+
+@dataclass
 class Strapdown:
     nav: NavState
-    prev_dtheta_p: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    prev_dv_p: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    prev_dvel_n: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    has_prev: bool = False
+    hist: History = field(default_factory=History)
+    prev_dvel_n: np.ndarray = field(default_factory=_zeros)
     vertical: int = VERTICAL_HOLD
     ref_height: float = 0.0
 
 
-def compensate(dtheta, dv, prev_dtheta, prev_dv):
-    """Two-sample coning, sculling and rotation compensation.
+def compensate(dtheta, dv, h):
+    """Coning, sculling, rotation compensation; returns ``(phi, dv_p)``.
 
-    Returns ``(phi, dv_p)``; see ``pyins::strapdown::compensate``.
+    Mirrors ``pyins::strapdown::compensate``.
     """
-    phi = dtheta + ONE_TWELFTH * cross(prev_dtheta, dtheta)
-    dv_rot = 0.5 * cross(dtheta, dv)
-    dv_scul = ONE_TWELFTH * (cross(prev_dtheta, dv) + cross(prev_dv, dtheta))
-    dv_p = dv + dv_rot + dv_scul
+    cone = np.zeros(3)
+    scul = np.zeros(3)
+    if h.count >= 2:
+        cone = (C3_NEAR * cross(h.dtheta1, dtheta) + C3_FAR * cross(h.dtheta2, dtheta)
+                + C3_PAST * cross(h.dtheta2, h.dtheta1))
+        scul = (C3_NEAR * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta))
+                + C3_FAR * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta))
+                + C3_PAST * (cross(h.dtheta2, h.dv1) + cross(h.dv2, h.dtheta1)))
+    elif h.count == 1:
+        cone = ONE_TWELFTH * cross(h.dtheta1, dtheta)
+        scul = ONE_TWELFTH * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta))
+    phi = dtheta + cone
+    dv_rot = 0.5 * cross(dtheta, dv) + ONE_SIXTH * cross(dtheta, cross(dtheta, dv))
+    dv_p = dv + dv_rot + scul
     return phi, dv_p
 
 
@@ -61,10 +88,8 @@ def make_strapdown(nav, vertical):
 
 def update(s, dtheta_p, dv_p, dt):
     """One update over a tick of ``dt`` seconds (mirrors ``strapdown::update``)."""
-    # 1. Coning, sculling, rotation compensation (zero before the first tick).
-    prev_dtheta = s.prev_dtheta_p if s.has_prev else dtheta_p
-    prev_dv = s.prev_dv_p if s.has_prev else dv_p
-    phi, dv_comp = compensate(dtheta_p, dv_p, prev_dtheta, prev_dv)
+    # 1. Coning, sculling and rotation compensation.
+    phi, dv_comp = compensate(dtheta_p, dv_p, s.hist)
 
     # 2. Earth at the start position, velocity extrapolated to mid-tick.
     vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n
@@ -106,6 +131,9 @@ def update(s, dtheta_p, dv_p, dt):
     # 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n
     s.nav.vel_n = vel_new
-    s.prev_dtheta_p = np.array(dtheta_p, dtype=float)
-    s.prev_dv_p = np.array(dv_p, dtype=float)
-    s.has_prev = True
+    s.hist.dtheta2 = s.hist.dtheta1
+    s.hist.dv2 = s.hist.dv1
+    s.hist.dtheta1 = np.array(dtheta_p, dtype=float)
+    s.hist.dv1 = np.array(dv_p, dtype=float)
+    if s.hist.count < 2:
+        s.hist.count = s.hist.count + 1

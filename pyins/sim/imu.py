@@ -306,6 +306,16 @@ def truth(motion, n_ticks, dt=0.01, t0=0.0, table=None, start_tick=0):
     Parameters are those of `exact_increments`. Returns a `Truth`.
     """
     ticks = np.arange(start_tick, start_tick + int(n_ticks), dtype=np.int64)
+    return truth_at(motion, ticks + 1, dt=dt, t0=t0, table=table)
+
+
+def truth_at(motion, sample_ticks, dt=0.01, t0=0.0, table=None):
+    """True state at the end of the given ticks: sample number k ends at t0 + k dt.
+
+    ``sample_ticks`` may be any int array (e.g. the ``tick`` field of
+    decimated firmware records). Returns a `Truth`.
+    """
+    ticks = np.asarray(sample_ticks, dtype=np.int64) - 1
     t_hi, t_lo = split_times(ticks + 1, dt, t0)
     st = motion.state(t_hi, t_lo)
     euler = st.euler.copy()

@@ -8,6 +8,7 @@ few ulp: TOL_UNIT = 4.4e-16 is 2 ulp at 1.0 (and 1e-15 rad = 2e-10 arc-sec).
 """
 import numpy as np
 from hypothesis import example, given
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
 import hooks
@@ -79,26 +80,29 @@ def test_rot_z_and_heading(a):
     assert hooks.lib.pyins_t_heading_to_yaw(a) == attitude.heading_to_yaw(a)
 
 
-@given(dtheta=vectors(0.01), dv=vectors(0.5), prev_dtheta=vectors(0.01), prev_dv=vectors(0.5))
-def test_compensate_bit_identical(dtheta, dv, prev_dtheta, prev_dv):
-    phi_c, dv_c = hooks.compensate(dtheta, dv, prev_dtheta, prev_dv)
-    phi_r, dv_r = strapdown.compensate(dtheta, dv, prev_dtheta, prev_dv)
+def histories():
+    return st.builds(strapdown.History, vectors(0.01), vectors(0.5), vectors(0.01), vectors(0.5),
+                     st.sampled_from([0, 1, 2]))
+
+
+@given(dtheta=vectors(0.01), dv=vectors(0.5), h=histories())
+def test_compensate_bit_identical(dtheta, dv, h):
+    phi_c, dv_c = hooks.compensate(dtheta, dv, h)
+    phi_r, dv_r = strapdown.compensate(dtheta, dv, h)
     assert_array_equal(phi_c, phi_r)
     assert_array_equal(dv_c, dv_r)
 
 
 @given(lat=latitudes(), h=heights(), vel=vectors(15.0), e=euler_angles(),
-       dtheta=vectors(0.005), dv=vectors(0.2), prev_dtheta=vectors(0.005), prev_dv=vectors(0.2),
-       prev_dvel=vectors(0.01), has_prev=finite(0, 1).map(lambda x: x > 0.5),
-       free=finite(0, 1).map(lambda x: x > 0.7))
-def test_strapdown_update_one_tick(lat, h, vel, e, dtheta, dv, prev_dtheta, prev_dv, prev_dvel,
-                                   has_prev, free):
+       dtheta=vectors(0.005), dv=vectors(0.2), hist=histories(),
+       prev_dvel=vectors(0.01), free=st.booleans())
+def test_strapdown_update_one_tick(lat, h, vel, e, dtheta, dv, hist, prev_dvel, free):
     """One update from a random state: position to 1e-15 rad (~6 nm), velocity
     to 1e-15 m/s, attitude to 2 ulp: a few roundings of difference between
     Eigen's and NumPy's 3x3 product and the portable vs libm sin/cos."""
     nav = strapdown.NavState(lat, 0.3, h, vel.copy(), attitude.euler_to_quat(e))
     s = strapdown.make_strapdown(nav, strapdown.VERTICAL_FREE if free else strapdown.VERTICAL_HOLD)
-    s.prev_dtheta_p, s.prev_dv_p, s.prev_dvel_n, s.has_prev = prev_dtheta, prev_dv, prev_dvel, has_prev
+    s.hist, s.prev_dvel_n = hist, prev_dvel
     c = hooks.strapdown_state(s)
     hooks.strapdown_update(c, dtheta, dv, 0.01)
     strapdown.update(s, dtheta, dv, 0.01)
@@ -106,5 +110,6 @@ def test_strapdown_update_one_tick(lat, h, vel, e, dtheta, dv, prev_dtheta, prev
     assert abs(c.height - s.nav.height) <= 1e-9     # m; h ~ 1e4 m carries 2e-12 m ulps
     assert_allclose(list(c.vel_n), s.nav.vel_n, rtol=0, atol=1e-15)
     assert_allclose(list(c.quat_np), s.nav.quat_np, rtol=0, atol=TOL_UNIT)
-    assert_array_equal(list(c.prev_dtheta_p), dtheta)
-    assert c.has_prev == 1
+    assert_array_equal(list(c.dtheta1), dtheta)
+    assert_array_equal(list(c.dtheta2), s.hist.dtheta2)
+    assert c.hist_count == s.hist.count
