@@ -149,6 +149,10 @@ Mat3 mat_orthonormalize(const Mat3& m) { return quat_to_mat(mat_to_quat(m)); }
 // std::fmod is exact in IEEE arithmetic (its result is representable), so it
 // gives the same bits on glibc and newlib, unlike sin/cos/atan2.
 double yaw_to_heading(double yaw) {
+    if (yaw > -kPi && yaw <= kPi) {  // the usual case (yaw from atan2): no fmod
+        const double h = -yaw;
+        return (h < 0.0 ? h + kTwoPi : h) + 0.0;  // + 0.0 turns -0.0 into +0.0
+    }
     double h = std::fmod(-yaw, kTwoPi);
     if (h < 0.0) {
         h = h + kTwoPi;

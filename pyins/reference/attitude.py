@@ -199,6 +199,9 @@ def mat_orthonormalize(m):
 
 def yaw_to_heading(yaw):
     """Marine heading [rad], clockwise from North in [0, 2 pi), from yaw (CCW)."""
+    if -np.pi < yaw <= np.pi:      # the usual case (yaw from atan2): no fmod
+        h = -yaw
+        return (h + TWO_PI if h < 0.0 else h) + 0.0   # + 0.0 turns -0.0 into +0.0
     h = np.fmod(-yaw, TWO_PI)
     if h < 0.0:
         h = h + TWO_PI

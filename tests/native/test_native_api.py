@@ -133,3 +133,32 @@ def test_decimated_run_matches_full_run_in_phase():
     assert dec.tobytes() == full[99:1000:100].tobytes()
     with pytest.raises(ValueError, match="every: must be a positive"):
         fw.run(s, every=0)
+
+
+@pytest.mark.parametrize("lib_path, message", [
+    ("/nonexistent/libpyins_core.so", "was not found"),
+    ("libm", "is not a pyins core library"),
+])
+def test_import_fails_with_one_clear_message(tmp_path, lib_path, message):
+    """A missing or wrong library makes `import pyins.native` fail with a
+    message that says what to run, not with a cffi traceback later."""
+    import ctypes.util
+    import os
+    import subprocess
+    import sys
+    if lib_path == "libm":
+        libm = ctypes.util.find_library("m")
+        libm = next((os.path.join(d, "libm.so.6") for d in ("/lib/x86_64-linux-gnu", "/lib/aarch64-linux-gnu",
+                                                             "/usr/lib64", "/lib64")
+                     if os.path.exists(os.path.join(d, "libm.so.6"))), libm)
+        (tmp_path / "lib.so").symlink_to(libm)
+        for h in ("pyins_core.h", "pyins_core_testing.h"):   # headers beside it, as installed
+            (tmp_path / h).write_text((native.LIBRARY_PATH.parent / h).read_text())
+        lib_path = str(tmp_path / "lib.so")
+    env = dict(os.environ, PYINS_CORE_LIB=lib_path)
+    res = subprocess.run([sys.executable, "-c", "import pyins.native"], env=env,
+                         capture_output=True, text=True)
+    assert res.returncode != 0
+    last = res.stderr.strip().splitlines()[-1]
+    assert last.startswith("ImportError: pyins:") and message in last
+    assert "pip install ." in last
