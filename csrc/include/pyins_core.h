@@ -26,7 +26,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 1
+#define PYINS_ABI_VERSION_MINOR 2
 
 #ifdef __cplusplus
 extern "C" {
@@ -54,7 +54,24 @@ enum pyins_status {
     PYINS_E_CONFIG_HEIGHT = -13,    /* height not finite or outside -1e4..1e5 m */
     PYINS_E_CONFIG_VEL = -14,       /* velocity not finite or faster than 1e4 m/s */
     PYINS_E_CONFIG_ATT = -15,       /* attitude or table angle not finite */
-    PYINS_E_CONFIG_MODE = -16       /* unknown vertical-channel mode */
+    PYINS_E_CONFIG_MODE = -16,      /* unknown vertical-channel mode */
+    PYINS_E_CONFIG_ALIGN_RATIO = -17, /* coarse_ratio not in (0, 1) */
+    PYINS_E_CONFIG_ALIGN_EARLY = -18, /* first coarse output before enough data: ratio * first < every */
+    PYINS_E_CONFIG_ALIGN_LONG = -19,  /* coarse alignment longer than its fixed storage allows */
+    PYINS_E_CONFIG_ALIGN_TICKS = -20  /* an alignment duration negative, or first output after its end */
+};
+
+/* Firmware modes, in pyins_output.mode. */
+enum pyins_mode {
+    PYINS_MODE_IDLE = 0,          /* initialised, no sample yet */
+    PYINS_MODE_COARSE_ALIGN = 1,  /* inertial-frame coarse alignment (seed 000) */
+    PYINS_MODE_FINE_ALIGN = 2,    /* Kalman fine alignment (seed 001) */
+    PYINS_MODE_NAVIGATE = 3
+};
+
+/* Bits of pyins_output.state_flags. */
+enum pyins_state_flag {
+    PYINS_STATE_ATT_VALID = 1     /* the attitude is a solution, not the configured guess */
 };
 
 /* Vertical channel: a marine INS holds height at the reference (external
@@ -75,6 +92,13 @@ typedef struct pyins_config {
     double vel_n_mps[3];          /* initial velocity, ENU [m/s] */
     double euler_b_rad[3];        /* initial ship attitude [pitch, roll, yaw] [rad] */
     double table_angle_rad;       /* turntable angle alpha at the initial time [rad] */
+    /* Alignment. With coarse_ticks = 0 the firmware navigates from the
+     * configured attitude; the position above is the alignment site. */
+    int32_t coarse_ticks;         /* COARSE_ALIGN duration [ticks]; 0 = none */
+    int32_t coarse_first_output_ticks; /* first coarse solution [ticks]; 0 = 20 s */
+    int32_t coarse_output_every_ticks; /* then one every [ticks]; 0 = 1 s */
+    int32_t reserved0;            /* padding, ignored; keep 0 */
+    double coarse_ratio;          /* r = t_k1 / t_k2 in (0, 1); 0 = 1/2 */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -87,8 +111,10 @@ typedef struct pyins_sample {
 /* One output record per step, the state at t_k. */
 typedef struct pyins_output {
     int64_t tick;                 /* number of samples accepted since init */
-    int32_t mode;                 /* firmware mode (1 = NAVIGATE) */
+    int32_t mode;                 /* enum pyins_mode */
     uint32_t fault_flags;         /* bit field, 0 = healthy */
+    uint32_t state_flags;         /* enum pyins_state_flag bits */
+    int32_t reserved0;
     double lat_rad;               /* geodetic latitude [rad] */
     double lon_rad;               /* longitude [rad] */
     double height_m;              /* height [m] */

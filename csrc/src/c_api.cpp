@@ -202,6 +202,10 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_VEL: return "PYINS_E_CONFIG_VEL: velocity must be finite and below 1e4 m/s per axis";
         case PYINS_E_CONFIG_ATT: return "PYINS_E_CONFIG_ATT: attitude angles and table angle must be finite";
         case PYINS_E_CONFIG_MODE: return "PYINS_E_CONFIG_MODE: vertical_mode must be PYINS_VERTICAL_HOLD or PYINS_VERTICAL_FREE";
+        case PYINS_E_CONFIG_ALIGN_RATIO: return "PYINS_E_CONFIG_ALIGN_RATIO: coarse_ratio must be in (0, 1) (0 = default 1/2)";
+        case PYINS_E_CONFIG_ALIGN_EARLY: return "PYINS_E_CONFIG_ALIGN_EARLY: first coarse output before enough data (coarse_ratio * first output < output interval)";
+        case PYINS_E_CONFIG_ALIGN_LONG: return "PYINS_E_CONFIG_ALIGN_LONG: coarse alignment longer than its storage allows (255 output intervals)";
+        case PYINS_E_CONFIG_ALIGN_TICKS: return "PYINS_E_CONFIG_ALIGN_TICKS: an alignment duration is negative, or the first output comes after its end";
         default: return "unknown pyins status code";
     }
 }

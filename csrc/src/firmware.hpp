@@ -8,18 +8,23 @@
 #include <cstdint>
 
 #include "pyins_core.h"
+#include "coarse_align.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 
 namespace pyins::firmware {
 
-/// Firmware modes, as reported in pyins_output.mode.
-enum class Mode : int32_t { kIdle = 0, kNavigate = 1 };
+/// Firmware modes, as reported in pyins_output.mode (enum pyins_mode).
+enum class Mode : int32_t { kIdle = 0, kCoarseAlign = 1, kFineAlign = 2, kNavigate = 3 };
 
 inline constexpr int32_t kDefaultTickHz = 100;
 inline constexpr int32_t kMaxTickHz = 10000;
 /// The ENU frame is singular at the poles: latitudes beyond this are refused.
 inline constexpr double kMaxLatRad = 89.9 * 3.14159265358979323846 / 180.0;
+/// Coarse alignment defaults, in seconds (seed 000: first output 20 s, then 1 s).
+inline constexpr int32_t kDefaultCoarseFirstS = 20;
+inline constexpr int32_t kDefaultCoarseEveryS = 1;
+inline constexpr double kDefaultCoarseRatio = 0.5;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -28,6 +33,9 @@ void config_default(pyins_config* cfg);
 
 /// PYINS_OK or the first PYINS_E_CONFIG_* that applies.
 int config_check(const pyins_config& cfg);
+
+/// The configuration with every zero-means-default field resolved.
+pyins_config config_resolved(const pyins_config& cfg);
 
 class Firmware {
   public:
@@ -45,11 +53,17 @@ class Firmware {
     int64_t tick() const { return tick_; }
 
   private:
+    /// Leave coarse alignment: navigation starts from its attitude.
+    void end_coarse();
+
     uint32_t magic_;
     Mode mode_;
     int64_t tick_;
     double dt_;                   ///< tick period [s]
+    pyins_config cfg_;            ///< resolved configuration
     strapdown::Strapdown sd_;
+    coarse_align::CoarseAlign coarse_;
+    bool att_valid_;              ///< attitude is a solution (not the configured guess)
     double table_angle_;          ///< unwrapped turntable angle alpha [rad]
     double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]
     double enc_sin_half_;         ///< sin(encoder_ / 2), kept with encoder_

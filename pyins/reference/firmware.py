@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from . import attitude, strapdown
+from . import attitude, coarse_align, earth, strapdown
 
 # Status codes: pinned values of enum pyins_status.
 PYINS_OK = 0
@@ -26,9 +26,21 @@ PYINS_E_CONFIG_HEIGHT = -13
 PYINS_E_CONFIG_VEL = -14
 PYINS_E_CONFIG_ATT = -15
 PYINS_E_CONFIG_MODE = -16
+PYINS_E_CONFIG_ALIGN_RATIO = -17
+PYINS_E_CONFIG_ALIGN_EARLY = -18
+PYINS_E_CONFIG_ALIGN_LONG = -19
+PYINS_E_CONFIG_ALIGN_TICKS = -20
 
-MODE_IDLE = 0       #: Mode::kIdle
-MODE_NAVIGATE = 1   #: Mode::kNavigate
+MODE_IDLE = 0          #: Mode::kIdle
+MODE_COARSE_ALIGN = 1  #: Mode::kCoarseAlign
+MODE_FINE_ALIGN = 2    #: Mode::kFineAlign
+MODE_NAVIGATE = 3      #: Mode::kNavigate
+
+STATE_ATT_VALID = 1    #: PYINS_STATE_ATT_VALID
+
+DEFAULT_COARSE_FIRST_S = 20     #: kDefaultCoarseFirstS
+DEFAULT_COARSE_EVERY_S = 1      #: kDefaultCoarseEveryS
+DEFAULT_COARSE_RATIO = 0.5      #: kDefaultCoarseRatio
 
 DEFAULT_TICK_HZ = 100          #: kDefaultTickHz
 MAX_TICK_HZ = 10000            #: kMaxTickHz
@@ -48,17 +60,37 @@ def config_default():
         "vel_n_mps": np.zeros(3),
         "euler_b_rad": np.zeros(3),
         "table_angle_rad": 0.0,
+        "coarse_ticks": 0,
+        "coarse_first_output_ticks": 0,
+        "coarse_output_every_ticks": 0,
+        "reserved0": 0,
+        "coarse_ratio": 0.0,
     }
+
+
+def config_resolved(cfg):
+    """The configuration with the zero-means-default fields resolved."""
+    cfg = dict(cfg)
+    if cfg["tick_hz"] == 0:
+        cfg["tick_hz"] = DEFAULT_TICK_HZ
+    if cfg["coarse_first_output_ticks"] == 0:
+        cfg["coarse_first_output_ticks"] = DEFAULT_COARSE_FIRST_S * cfg["tick_hz"]
+    if cfg["coarse_output_every_ticks"] == 0:
+        cfg["coarse_output_every_ticks"] = DEFAULT_COARSE_EVERY_S * cfg["tick_hz"]
+    if cfg["coarse_ratio"] == 0.0:
+        cfg["coarse_ratio"] = DEFAULT_COARSE_RATIO
+    return cfg
 
 
 def _finite3(v):
     return all(math.isfinite(x) for x in v)
 
 
-def config_check(cfg):
+def config_check(raw):
     """PYINS_OK or the first PYINS_E_CONFIG_* that applies (mirrors config_check)."""
-    if cfg["tick_hz"] < 0 or cfg["tick_hz"] > MAX_TICK_HZ:
+    if raw["tick_hz"] < 0 or raw["tick_hz"] > MAX_TICK_HZ:
         return PYINS_E_CONFIG_RATE
+    cfg = config_resolved(raw)
     if not math.isfinite(cfg["lat_rad"]) or abs(cfg["lat_rad"]) > MAX_LAT_RAD:
         return PYINS_E_CONFIG_LAT
     if not math.isfinite(cfg["lon_rad"]) or abs(cfg["lon_rad"]) > 2.0 * TWO_PI:
@@ -73,6 +105,18 @@ def config_check(cfg):
         return PYINS_E_CONFIG_ATT
     if cfg["vertical_mode"] not in (strapdown.VERTICAL_HOLD, strapdown.VERTICAL_FREE):
         return PYINS_E_CONFIG_MODE
+    if cfg["coarse_ticks"] < 0 or cfg["coarse_first_output_ticks"] < 0 or cfg["coarse_output_every_ticks"] < 0:
+        return PYINS_E_CONFIG_ALIGN_TICKS
+    if not (0.0 < cfg["coarse_ratio"] < 1.0):
+        return PYINS_E_CONFIG_ALIGN_RATIO
+    if cfg["coarse_ticks"] > 0:
+        every = cfg["coarse_output_every_ticks"]
+        if cfg["coarse_first_output_ticks"] > cfg["coarse_ticks"]:
+            return PYINS_E_CONFIG_ALIGN_TICKS
+        if cfg["coarse_ratio"] * float(cfg["coarse_first_output_ticks"]) < float(every):
+            return PYINS_E_CONFIG_ALIGN_EARLY
+        if cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1:
+            return PYINS_E_CONFIG_ALIGN_LONG
     return PYINS_OK
 
 
@@ -111,10 +155,12 @@ class Firmware:
             raise ValueError(f"configuration refused with status {status}")
         self.init(full)
 
-    def init(self, cfg):
-        hz = DEFAULT_TICK_HZ if cfg["tick_hz"] == 0 else cfg["tick_hz"]
-        self.dt = 1.0 / float(hz)
-        self.mode = MODE_NAVIGATE
+    def init(self, raw):
+        cfg = config_resolved(raw)
+        self.cfg = cfg
+        self.dt = 1.0 / float(cfg["tick_hz"])
+        self.mode = MODE_IDLE
+        self.att_valid = cfg["coarse_ticks"] == 0
         self.tick = 0
         self.table_angle = cfg["table_angle_rad"]
         self.encoder = wrap_two_pi(cfg["table_angle_rad"])
@@ -129,13 +175,39 @@ class Firmware:
                                  np.array(cfg["vel_n_mps"], dtype=float),
                                  attitude.mat_to_quat(mat_np))
         self.sd = strapdown.make_strapdown(nav, cfg["vertical_mode"])
+        self.coarse = None
+        if cfg["coarse_ticks"] > 0:
+            sin_lat, cos_lat = np.sin(cfg["lat_rad"]), np.cos(cfg["lat_rad"])
+            prm = coarse_align.Params(
+                ratio=cfg["coarse_ratio"], first_output=cfg["coarse_first_output_ticks"],
+                output_every=cfg["coarse_output_every_ticks"], dt=self.dt, sin_lat=sin_lat,
+                cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]))
+            self.coarse = coarse_align.init(prm)
+
+    def end_coarse(self):
+        """Navigation starts from the coarse attitude, at rest, with its history."""
+        nav = self.sd.nav
+        nav = strapdown.NavState(nav.lat, nav.lon, nav.height, np.zeros(3),
+                                 attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse)))
+        self.sd = strapdown.make_strapdown(nav, self.sd.vertical)
+        self.sd.hist = self.coarse.hist
+        self.att_valid = True
+        self.mode = MODE_NAVIGATE
 
     def step(self, dtheta_p, dv_p, table_angle_rad):
         """One tick; returns ``(status, output dict)``."""
         if not (_finite3(dtheta_p) and _finite3(dv_p) and math.isfinite(table_angle_rad)):
             return PYINS_E_SAMPLE_NONFINITE, self.output()
-        strapdown.update(self.sd, np.asarray(dtheta_p, dtype=float),
-                         np.asarray(dv_p, dtype=float), self.dt)
+        dtheta_p = np.asarray(dtheta_p, dtype=float)
+        dv_p = np.asarray(dv_p, dtype=float)
+        if self.mode == MODE_IDLE:
+            self.mode = MODE_COARSE_ALIGN if self.cfg["coarse_ticks"] > 0 else MODE_NAVIGATE
+        if self.mode == MODE_COARSE_ALIGN:
+            coarse_align.update(self.coarse, dtheta_p, dv_p)
+            if self.coarse.tick == self.cfg["coarse_ticks"]:
+                self.end_coarse()
+        else:
+            strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
         encoder = wrap_two_pi(table_angle_rad)
         self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
         if encoder != self.encoder:   # the table moved: refresh the cached half-angle
@@ -148,18 +220,24 @@ class Firmware:
     def output(self):
         nav = self.sd.nav
         q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
-        q_nb = attitude.quat_normalize(attitude.quat_mul(nav.quat_np, q_pb))
+        q_np = nav.quat_np
+        valid = self.att_valid
+        if self.mode == MODE_COARSE_ALIGN and self.coarse.solved:
+            q_np = attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse))
+            valid = True
+        q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
         return {
             "tick": self.tick,
             "mode": self.mode,
             "fault_flags": 0,
+            "state_flags": STATE_ATT_VALID if valid else 0,
             "lat_rad": nav.lat,
             "lon_rad": nav.lon,
             "height_m": nav.height,
             "vel_n_mps": nav.vel_n.copy(),
             "quat_nb": q_nb,
-            "quat_np": nav.quat_np.copy(),
+            "quat_np": q_np.copy(),
             "euler_b_rad": euler_b,
             "heading_b_rad": attitude.yaw_to_heading(euler_b[2]),
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),

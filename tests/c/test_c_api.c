@@ -67,7 +67,9 @@ int main(void) {
                              PYINS_E_NOT_INIT, PYINS_E_SAMPLE_NONFINITE, PYINS_E_BAD_ARG,
                              PYINS_E_BUFFER_TOO_SMALL, PYINS_E_CONFIG_RATE,
                              PYINS_E_CONFIG_LAT, PYINS_E_CONFIG_LON, PYINS_E_CONFIG_HEIGHT,
-                             PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE};
+                             PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE,
+                             PYINS_E_CONFIG_ALIGN_RATIO, PYINS_E_CONFIG_ALIGN_EARLY,
+                             PYINS_E_CONFIG_ALIGN_LONG, PYINS_E_CONFIG_ALIGN_TICKS};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
         int distinct = 1;
@@ -118,6 +120,17 @@ int main(void) {
     BAD_CFG(b.euler_b_rad[2] = INFINITY, PYINS_E_CONFIG_ATT, "yaw Inf");
     BAD_CFG(b.table_angle_rad = NAN, PYINS_E_CONFIG_ATT, "table angle NaN");
     BAD_CFG(b.vertical_mode = 7, PYINS_E_CONFIG_MODE, "vertical mode unknown");
+    BAD_CFG((b.coarse_ticks = 15000, b.coarse_ratio = 1.0), PYINS_E_CONFIG_ALIGN_RATIO, "ratio 1");
+    BAD_CFG((b.coarse_ticks = 15000, b.coarse_ratio = -0.25), PYINS_E_CONFIG_ALIGN_RATIO, "ratio negative");
+    BAD_CFG((b.coarse_ticks = 15000, b.coarse_ratio = NAN), PYINS_E_CONFIG_ALIGN_RATIO, "ratio NaN");
+    BAD_CFG((b.coarse_ticks = 15000, b.coarse_first_output_ticks = 150), PYINS_E_CONFIG_ALIGN_EARLY,
+            "first output before enough data");
+    BAD_CFG((b.coarse_ticks = 15000, b.coarse_ratio = 0.01), PYINS_E_CONFIG_ALIGN_EARLY,
+            "ratio too small for the first output");
+    BAD_CFG(b.coarse_ticks = 30000, PYINS_E_CONFIG_ALIGN_LONG, "coarse alignment beyond storage");
+    BAD_CFG(b.coarse_ticks = -1, PYINS_E_CONFIG_ALIGN_TICKS, "negative coarse duration");
+    BAD_CFG((b.coarse_ticks = 1000, b.coarse_first_output_ticks = 2000), PYINS_E_CONFIG_ALIGN_TICKS,
+            "first output after the end");
 
     /* init: NULL, misaligned, too small. */
     check_status(pyins_init(NULL, size, &cfg), PYINS_E_NULL, "init NULL mem");
@@ -146,7 +159,7 @@ int main(void) {
         check_status(pyins_run(core, NULL, 0, NULL, NULL), PYINS_OK, "run zero samples");
 
         check_status(pyins_step(core, &s, &out), PYINS_OK, "step");
-        check(out.tick == 1 && out.mode == 1 && out.fault_flags == 0u, "tick, mode, faults after one step");
+        check(out.tick == 1 && out.mode == PYINS_MODE_NAVIGATE && out.fault_flags == 0u, "tick, mode, faults after one step");
         check_status(pyins_get_output(core, &before), PYINS_OK, "get_output");
         /* Each non-finite field rejected; state untouched. */
         {

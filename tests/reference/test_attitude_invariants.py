@@ -94,3 +94,20 @@ def test_rotvec_series_branch_equals_closed_form(angle, u):
     half = 0.5 * angle
     closed = np.concatenate([[np.cos(half)], np.sin(half) / angle * v])
     assert_allclose(attitude.rotvec_to_quat(v), closed, rtol=0, atol=2.2e-16)
+
+
+@given(q=quaternions(), v1=st.tuples(*[st.floats(-1, 1)] * 3), v2=st.tuples(*[st.floats(-1, 1)] * 3),
+       noise=st.floats(0.0, 1e-3))
+def test_coarse_triad_is_a_rotation_and_exact_without_noise(q, v1, v2, noise):
+    """The TRIAD replacing seed 000 eq. 8 is a proper rotation even with
+    noisy vectors, and recovers the rotation exactly from noise-free ones."""
+    from hypothesis import assume
+
+    from pyins.reference import coarse_align
+    v1, v2 = np.array(v1), np.array(v2)
+    assume(np.linalg.norm(np.cross(v1, v2)) > 1e-2 and np.linalg.norm(v2) > 1e-2)
+    c = attitude.quat_to_mat(q)
+    exact = coarse_align.solve_mat_i_ib0(c @ v1, c @ v2, v1, v2)
+    assert_allclose(exact, c, rtol=0, atol=1e-13)   # conditioning of the pair, >= 1e-2
+    noisy = coarse_align.solve_mat_i_ib0(c @ v1 + noise, c @ v2 - noise, v1, v2)
+    _proper_rotation(noisy)
