@@ -26,7 +26,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 2
+#define PYINS_ABI_VERSION_MINOR 3
 
 #ifdef __cplusplus
 extern "C" {
@@ -58,7 +58,20 @@ enum pyins_status {
     PYINS_E_CONFIG_ALIGN_RATIO = -17, /* coarse_ratio not in (0, 1) */
     PYINS_E_CONFIG_ALIGN_EARLY = -18, /* first coarse output before enough data: ratio * first < every */
     PYINS_E_CONFIG_ALIGN_LONG = -19,  /* coarse alignment longer than its fixed storage allows */
-    PYINS_E_CONFIG_ALIGN_TICKS = -20  /* an alignment duration negative, or first output after its end */
+    PYINS_E_CONFIG_ALIGN_TICKS = -20, /* an alignment duration negative, or first output after its end */
+    PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5 or 8, negative update interval, unknown correction */
+    PYINS_E_CONFIG_NOISE = -22        /* a noise density or initial sigma negative or not finite */
+};
+
+/* How the fine alignment uses its attitude estimate. */
+enum pyins_fine_correction {
+    PYINS_FINE_FEEDBACK = 0,      /* correct the attitude after every update (seed 001's advice) */
+    PYINS_FINE_OPEN_LOOP = 1      /* leave it; report the corrected attitude */
+};
+
+/* Bits of pyins_output.fault_flags (sticky). */
+enum pyins_fault_flag {
+    PYINS_FAULT_KF_NOT_PD = 1     /* the fine-alignment covariance lost positive definiteness */
 };
 
 /* Firmware modes, in pyins_output.mode. */
@@ -99,6 +112,15 @@ typedef struct pyins_config {
     int32_t coarse_output_every_ticks; /* then one every [ticks]; 0 = 1 s */
     int32_t reserved0;            /* padding, ignored; keep 0 */
     double coarse_ratio;          /* r = t_k1 / t_k2 in (0, 1); 0 = 1/2 */
+    int32_t fine_ticks;           /* FINE_ALIGN duration [ticks]; 0 = none */
+    int32_t fine_states;          /* 5 (reduced filter) or 8 (full); 0 = 5 */
+    int32_t fine_meas_every_ticks; /* ticks per measurement update; 0 = 10 */
+    int32_t fine_correction;      /* enum pyins_fine_correction */
+    double fine_gyro_arw;         /* Q: gyro angle random walk [rad/sqrt(s)]; 0 = 0.001 deg/sqrt(h) */
+    double fine_accel_vrw;        /* R: accelerometer velocity random walk [(m/s)/sqrt(s)]; 0 = 10 ug/sqrt(Hz) */
+    double fine_sigma0_att_rad[3]; /* initial sigma of phi E, N, U [rad]; 0 = 100', 100', 600' */
+    double fine_sigma0_gyro;      /* initial sigma of the gyro drifts [rad/s]; 0 = 0.01 deg/h */
+    double fine_sigma0_accel;     /* initial sigma of the accelerometer biases [m/s^2]; 0 = 100 ug */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -125,6 +147,10 @@ typedef struct pyins_output {
     double heading_b_rad;         /* ship heading, clockwise from North, [0, 2 pi) [rad] */
     double yaw_p_rad;             /* IMU yaw psi_p = psi_b + alpha, CCW, (-pi, pi] [rad] */
     double table_angle_rad;       /* unwrapped turntable angle alpha [rad] */
+    int32_t kf_states;            /* 0 before fine alignment, else 5 or 8 (its last values stay) */
+    int32_t reserved1;
+    double kf_x[8];               /* fine-alignment state, fine_align.hpp layout [rad, rad/s, m/s^2] */
+    double kf_sigma[8];           /* its standard deviations, same units */
 } pyins_output;
 
 /* The firmware instance. Opaque: it lives in caller memory of

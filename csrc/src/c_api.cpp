@@ -205,6 +205,8 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_ALIGN_RATIO: return "PYINS_E_CONFIG_ALIGN_RATIO: coarse_ratio must be in (0, 1) (0 = default 1/2)";
         case PYINS_E_CONFIG_ALIGN_EARLY: return "PYINS_E_CONFIG_ALIGN_EARLY: first coarse output before enough data (coarse_ratio * first output < output interval)";
         case PYINS_E_CONFIG_ALIGN_LONG: return "PYINS_E_CONFIG_ALIGN_LONG: coarse alignment longer than its storage allows (255 output intervals)";
+        case PYINS_E_CONFIG_FINE: return "PYINS_E_CONFIG_FINE: fine_states must be 5 or 8, the update interval positive, the correction known";
+        case PYINS_E_CONFIG_NOISE: return "PYINS_E_CONFIG_NOISE: noise densities and initial sigmas must be positive and finite (0 = default)";
         case PYINS_E_CONFIG_ALIGN_TICKS: return "PYINS_E_CONFIG_ALIGN_TICKS: an alignment duration is negative, or the first output comes after its end";
         default: return "unknown pyins status code";
     }
@@ -350,6 +352,7 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     sd.vertical = s->vertical == 1 ? pyins::strapdown::Vertical::kFree
                                    : pyins::strapdown::Vertical::kHold;
     sd.ref_height = s->ref_height;
+    sd.ref_lon = s->lon;
     pyins::strapdown::update(sd, v3(dtheta_p), v3(dv_p), dt);
     s->lat = sd.nav.lat;
     s->lon = sd.nav.lon;

@@ -63,6 +63,29 @@ pyins_config config_resolved(const pyins_config& in) {
     if (cfg.coarse_ratio == 0.0) {
         cfg.coarse_ratio = kDefaultCoarseRatio;
     }
+    if (cfg.fine_states == 0) {
+        cfg.fine_states = kDefaultFineStates;
+    }
+    if (cfg.fine_meas_every_ticks == 0) {
+        cfg.fine_meas_every_ticks = kDefaultFineMeasEvery;
+    }
+    if (cfg.fine_gyro_arw == 0.0) {
+        cfg.fine_gyro_arw = kDefaultFineArw;
+    }
+    if (cfg.fine_accel_vrw == 0.0) {
+        cfg.fine_accel_vrw = kDefaultFineVrw;
+    }
+    for (int i = 0; i < 3; ++i) {
+        if (cfg.fine_sigma0_att_rad[i] == 0.0) {
+            cfg.fine_sigma0_att_rad[i] = kDefaultFineSigmaAtt[i];
+        }
+    }
+    if (cfg.fine_sigma0_gyro == 0.0) {
+        cfg.fine_sigma0_gyro = kDefaultFineSigmaGyro;
+    }
+    if (cfg.fine_sigma0_accel == 0.0) {
+        cfg.fine_sigma0_accel = kDefaultFineSigmaAccel;
+    }
     return cfg;
 }
 
@@ -110,6 +133,21 @@ int config_check(const pyins_config& raw) {
             return PYINS_E_CONFIG_ALIGN_LONG;
         }
     }
+    if (cfg.fine_ticks < 0) {
+        return PYINS_E_CONFIG_ALIGN_TICKS;
+    }
+    if ((cfg.fine_states != 5 && cfg.fine_states != 8) || cfg.fine_meas_every_ticks < 0 ||
+        (cfg.fine_correction != PYINS_FINE_FEEDBACK && cfg.fine_correction != PYINS_FINE_OPEN_LOOP)) {
+        return PYINS_E_CONFIG_FINE;
+    }
+    const double noise[7] = {cfg.fine_gyro_arw, cfg.fine_accel_vrw, cfg.fine_sigma0_att_rad[0],
+                             cfg.fine_sigma0_att_rad[1], cfg.fine_sigma0_att_rad[2],
+                             cfg.fine_sigma0_gyro, cfg.fine_sigma0_accel};
+    for (double v : noise) {
+        if (!(v > 0.0) || !std::isfinite(v)) {
+            return PYINS_E_CONFIG_NOISE;
+        }
+    }
     return PYINS_OK;
 }
 
@@ -119,6 +157,8 @@ void Firmware::init(const pyins_config& raw) {
     dt_ = 1.0 / static_cast<double>(cfg.tick_hz);
     mode_ = Mode::kIdle;
     att_valid_ = cfg.coarse_ticks == 0;
+    kf_states_ = 0;
+    faults_ = 0u;
     tick_ = 0;
     table_angle_ = cfg.table_angle_rad;
     encoder_ = wrap_two_pi(cfg.table_angle_rad);
@@ -153,16 +193,71 @@ void Firmware::init(const pyins_config& raw) {
 }
 
 void Firmware::end_coarse() {
-    // Navigation starts where the alignment ends: the site position, at
-    // rest, with the coarse attitude and the increment history (so the
-    // coning terms continue without a gap).
+    // The next phase starts where the coarse alignment ends: the site
+    // position, at rest, with the coarse attitude and the increment history
+    // (so the coning terms continue without a gap).
     strapdown::NavState nav = sd_.nav;
     nav.vel_n = Vec3::Zero();
     nav.quat_np = attitude::mat_to_quat(coarse_align::mat_n_p(coarse_));
     sd_ = strapdown::make_strapdown(nav, sd_.vertical);
     sd_.hist = coarse_.hist;
     att_valid_ = true;
+    if (cfg_.fine_ticks > 0) {
+        start_fine();
+    } else {
+        mode_ = Mode::kNavigate;
+    }
+}
+
+void Firmware::start_fine() {
+    fine_align::Params prm;
+    pmath::sincos(cfg_.lat_rad, &prm.sin_lat, &prm.cos_lat);
+    prm.gravity = earth::normal_gravity(prm.sin_lat, cfg_.height_m);
+    prm.dt = dt_;
+    prm.meas_every = cfg_.fine_meas_every_ticks;
+    prm.gyro_arw = cfg_.fine_gyro_arw;
+    prm.accel_vrw = cfg_.fine_accel_vrw;
+    prm.sigma0_att[0] = cfg_.fine_sigma0_att_rad[0];
+    prm.sigma0_att[1] = cfg_.fine_sigma0_att_rad[1];
+    prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
+    prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
+    prm.sigma0_accel = cfg_.fine_sigma0_accel;
+    prm.feedback = cfg_.fine_correction == PYINS_FINE_FEEDBACK;
+    kf_states_ = cfg_.fine_states;
+    if (kf_states_ == 8) {
+        fine_align::init<8>(fine8_, prm);
+    } else {
+        fine_align::init<5>(fine5_, prm);
+    }
+    mode_ = Mode::kFineAlign;
+}
+
+Vec3 Firmware::fine_phi() const {
+    if (mode_ != Mode::kFineAlign) {
+        return Vec3::Zero();
+    }
+    return kf_states_ == 8 ? fine_align::phi<8>(fine8_) : fine_align::phi<5>(fine5_);
+}
+
+void Firmware::end_fine() {
+    // Navigation starts from the corrected attitude (both correction modes).
+    const Vec3 phi = fine_phi();
+    sd_.nav.quat_np = attitude::quat_normalize(
+        attitude::quat_mul(attitude::rotvec_to_quat(phi), sd_.nav.quat_np));
+    if (kf_states_ == 8) {
+        fine_align::reset_phi<8>(fine8_);
+    } else {
+        fine_align::reset_phi<5>(fine5_);
+    }
     mode_ = Mode::kNavigate;
+}
+
+void Firmware::hold_at_site() {
+    sd_.nav.lat = cfg_.lat_rad;
+    sd_.nav.lon = sd_.ref_lon;
+    sd_.nav.height = cfg_.height_m;
+    sd_.nav.vel_n = Vec3::Zero();
+    sd_.prev_dvel_n = Vec3::Zero();
 }
 
 int Firmware::step(const pyins_sample& sample, pyins_output* out) {
@@ -176,12 +271,47 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
     const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
     if (mode_ == Mode::kIdle) {
-        mode_ = cfg_.coarse_ticks > 0 ? Mode::kCoarseAlign : Mode::kNavigate;
+        if (cfg_.coarse_ticks > 0) {
+            mode_ = Mode::kCoarseAlign;
+        } else if (cfg_.fine_ticks > 0) {
+            start_fine();
+        } else {
+            mode_ = Mode::kNavigate;
+        }
     }
     if (mode_ == Mode::kCoarseAlign) {
         coarse_align::update(coarse_, dtheta_p, dv_p);
         if (coarse_.tick == cfg_.coarse_ticks) {
             end_coarse();
+        }
+    } else if (mode_ == Mode::kFineAlign) {
+        // Attitude by the strapdown; position and velocity held (static base).
+        const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
+        hold_at_site();
+        bool updated;
+        bool healthy;
+        if (kf_states_ == 8) {
+            updated = fine_align::step<8>(fine8_, dv_sf_n);
+            healthy = fine8_.healthy;
+        } else {
+            updated = fine_align::step<5>(fine5_, dv_sf_n);
+            healthy = fine5_.healthy;
+        }
+        if (!healthy) {
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
+        }
+        if (updated && cfg_.fine_correction == PYINS_FINE_FEEDBACK) {
+            const Vec3 phi = fine_phi();
+            sd_.nav.quat_np = attitude::quat_normalize(
+                attitude::quat_mul(attitude::rotvec_to_quat(phi), sd_.nav.quat_np));
+            if (kf_states_ == 8) {
+                fine_align::reset_phi<8>(fine8_);
+            } else {
+                fine_align::reset_phi<5>(fine5_);
+            }
+        }
+        if (tick_ + 1 == static_cast<int64_t>(cfg_.coarse_ticks) + cfg_.fine_ticks) {
+            end_fine();
         }
     } else {
         strapdown::update(sd_, dtheta_p, dv_p, dt_);
@@ -205,7 +335,7 @@ void Firmware::output(pyins_output* out) const {
     const strapdown::NavState& nav = sd_.nav;
     out->tick = tick_;
     out->mode = static_cast<int32_t>(mode_);
-    out->fault_flags = 0u;
+    out->fault_flags = faults_;
     out->reserved0 = 0;
     out->lat_rad = nav.lat;
     out->lon_rad = nav.lon;
@@ -222,6 +352,10 @@ void Firmware::output(pyins_output* out) const {
     if (mode_ == Mode::kCoarseAlign && coarse_.solved) {
         q_np = attitude::mat_to_quat(coarse_align::mat_n_p(coarse_));
         valid = true;
+    } else if (mode_ == Mode::kFineAlign) {
+        // the best estimate: the propagated attitude corrected by phi^
+        q_np = attitude::quat_normalize(
+            attitude::quat_mul(attitude::rotvec_to_quat(fine_phi()), nav.quat_np));
     }
     out->state_flags = valid ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
     const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(q_np, q_pb));
@@ -240,6 +374,23 @@ void Firmware::output(pyins_output* out) const {
     out->heading_b_rad = attitude::yaw_to_heading(euler_b(2));
     out->yaw_p_rad = wrap_pi(euler_b(2) + encoder_);
     out->table_angle_rad = table_angle_;
+    out->kf_states = kf_states_;
+    out->reserved1 = 0;
+    for (int i = 0; i < 8; ++i) {
+        out->kf_x[i] = 0.0;
+        out->kf_sigma[i] = 0.0;
+    }
+    if (kf_states_ == 8) {
+        for (int i = 0; i < 8; ++i) {
+            out->kf_x[i] = fine8_.x(i);
+            out->kf_sigma[i] = pmath::sqrt(fine8_.p(i, i));
+        }
+    } else if (kf_states_ == 5) {
+        for (int i = 0; i < 5; ++i) {
+            out->kf_x[i] = fine5_.x(i);
+            out->kf_sigma[i] = pmath::sqrt(fine5_.p(i, i));
+        }
+    }
 }
 
 }  // namespace pyins::firmware

@@ -9,6 +9,7 @@
 
 #include "pyins_core.h"
 #include "coarse_align.hpp"
+#include "fine_align.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 
@@ -25,6 +26,16 @@ inline constexpr double kMaxLatRad = 89.9 * 3.14159265358979323846 / 180.0;
 inline constexpr int32_t kDefaultCoarseFirstS = 20;
 inline constexpr int32_t kDefaultCoarseEveryS = 1;
 inline constexpr double kDefaultCoarseRatio = 0.5;
+/// Fine alignment defaults (seed 001 sec. 3.3; SPEC.md).
+inline constexpr int32_t kDefaultFineStates = 5;
+inline constexpr int32_t kDefaultFineMeasEvery = 10;             ///< 10 Hz updates at 100 Hz
+inline constexpr double kDefaultFineArw = 0.001 * (3.14159265358979323846 / 180.0) / 60.0;  ///< 0.001 deg/sqrt(h)
+inline constexpr double kDefaultFineVrw = 10.0e-6 * 9.80665;   ///< 10 ug/sqrt(Hz)
+inline constexpr double kArcminRad = 3.14159265358979323846 / 180.0 / 60.0;
+inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminRad, 100.0 * kArcminRad,
+                                                   600.0 * kArcminRad};  ///< 10 x [10', 10', 60']
+inline constexpr double kDefaultFineSigmaGyro = 0.01 * (3.14159265358979323846 / 180.0) / 3600.0;
+inline constexpr double kDefaultFineSigmaAccel = 100.0e-6 * 9.80665;  ///< 100 ug (not in seed 001)
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -53,8 +64,15 @@ class Firmware {
     int64_t tick() const { return tick_; }
 
   private:
-    /// Leave coarse alignment: navigation starts from its attitude.
+    /// Leave coarse alignment for fine alignment or navigation.
     void end_coarse();
+    /// Start / leave fine alignment.
+    void start_fine();
+    void end_fine();
+    /// The fine filter's attitude estimate phi^ [rad] (zero outside it).
+    Vec3 fine_phi() const;
+    /// Hold the static-base assumption of the alignment: site, at rest.
+    void hold_at_site();
 
     uint32_t magic_;
     Mode mode_;
@@ -63,6 +81,10 @@ class Firmware {
     pyins_config cfg_;            ///< resolved configuration
     strapdown::Strapdown sd_;
     coarse_align::CoarseAlign coarse_;
+    fine_align::FineAlign<5> fine5_;
+    fine_align::FineAlign<8> fine8_;
+    int32_t kf_states_;           ///< 0 until fine alignment starts, then 5 or 8
+    uint32_t faults_;             ///< sticky pyins_fault_flag bits
     bool att_valid_;              ///< attitude is a solution (not the configured guess)
     double table_angle_;          ///< unwrapped turntable angle alpha [rad]
     double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]

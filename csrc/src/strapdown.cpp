@@ -40,13 +40,14 @@ Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     s.prev_dvel_n = Vec3::Zero();
     s.vertical = vertical;
     s.ref_height = nav.height;
+    s.ref_lon = nav.lon;
     if (vertical == Vertical::kHold) {
         s.nav.vel_n(2) = 0.0;
     }
     return s;
 }
 
-void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
+Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     // 1. Coning, sculling and rotation compensation (strapdown.hpp).
     const Compensated c = compensate(dtheta_p, dv_p, s.hist);
 
@@ -105,6 +106,7 @@ void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     if (s.hist.count < 2) {
         s.hist.count = s.hist.count + 1;
     }
+    return dv_sf_n;
 }
 
 }  // namespace pyins::strapdown

@@ -55,6 +55,7 @@ struct Strapdown {
     Vec3 prev_dvel_n;     ///< v(k-1) - v(k-2), for the mid-tick velocity [m/s]
     Vertical vertical;
     double ref_height;    ///< height held in kHold mode [m]
+    double ref_lon;       ///< longitude at the start [rad] (the alignment site)
 };
 
 /// Two-sample coefficient (linear rate over two ticks): 1/12.
@@ -84,6 +85,8 @@ Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h);
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);
 
 /// One update over a tick of dt seconds. Precondition: finite inputs.
-void update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt);
+/// Returns the tick's specific-force velocity increment in n [m/s] (the
+/// fine alignment's measurement).
+Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt);
 
 }  // namespace pyins::strapdown

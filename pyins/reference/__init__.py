@@ -7,6 +7,6 @@ per-step and scalar on purpose. ``math_portable`` and ``c_api`` have no
 mirror: NumPy's own sin/cos/atan2 stand in for the core's portable ones, and
 the C ABI is Python's ``pyins.native``.
 """
-from . import attitude, coarse_align, earth, firmware, strapdown
+from . import attitude, coarse_align, earth, fine_align, firmware, kalman, strapdown
 
-__all__ = ["attitude", "coarse_align", "earth", "firmware", "strapdown"]
+__all__ = ["attitude", "coarse_align", "earth", "fine_align", "firmware", "kalman", "strapdown"]

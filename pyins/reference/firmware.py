@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from . import attitude, coarse_align, earth, strapdown
+from . import attitude, coarse_align, earth, fine_align, strapdown
 
 # Status codes: pinned values of enum pyins_status.
 PYINS_OK = 0
@@ -30,6 +30,12 @@ PYINS_E_CONFIG_ALIGN_RATIO = -17
 PYINS_E_CONFIG_ALIGN_EARLY = -18
 PYINS_E_CONFIG_ALIGN_LONG = -19
 PYINS_E_CONFIG_ALIGN_TICKS = -20
+PYINS_E_CONFIG_FINE = -21
+PYINS_E_CONFIG_NOISE = -22
+
+FINE_FEEDBACK = 0      #: PYINS_FINE_FEEDBACK
+FINE_OPEN_LOOP = 1     #: PYINS_FINE_OPEN_LOOP
+FAULT_KF_NOT_PD = 1    #: PYINS_FAULT_KF_NOT_PD
 
 MODE_IDLE = 0          #: Mode::kIdle
 MODE_COARSE_ALIGN = 1  #: Mode::kCoarseAlign
@@ -41,6 +47,14 @@ STATE_ATT_VALID = 1    #: PYINS_STATE_ATT_VALID
 DEFAULT_COARSE_FIRST_S = 20     #: kDefaultCoarseFirstS
 DEFAULT_COARSE_EVERY_S = 1      #: kDefaultCoarseEveryS
 DEFAULT_COARSE_RATIO = 0.5      #: kDefaultCoarseRatio
+DEFAULT_FINE_STATES = 5         #: kDefaultFineStates
+DEFAULT_FINE_MEAS_EVERY = 10    #: kDefaultFineMeasEvery
+DEFAULT_FINE_ARW = 0.001 * (np.pi / 180.0) / 60.0           #: kDefaultFineArw
+DEFAULT_FINE_VRW = 10.0e-6 * 9.80665                        #: kDefaultFineVrw
+ARCMIN_RAD = np.pi / 180.0 / 60.0                           #: kArcminRad
+DEFAULT_FINE_SIGMA_ATT = (100.0 * ARCMIN_RAD, 100.0 * ARCMIN_RAD, 600.0 * ARCMIN_RAD)
+DEFAULT_FINE_SIGMA_GYRO = 0.01 * (np.pi / 180.0) / 3600.0   #: kDefaultFineSigmaGyro
+DEFAULT_FINE_SIGMA_ACCEL = 100.0e-6 * 9.80665               #: kDefaultFineSigmaAccel
 
 DEFAULT_TICK_HZ = 100          #: kDefaultTickHz
 MAX_TICK_HZ = 10000            #: kMaxTickHz
@@ -65,6 +79,15 @@ def config_default():
         "coarse_output_every_ticks": 0,
         "reserved0": 0,
         "coarse_ratio": 0.0,
+        "fine_ticks": 0,
+        "fine_states": 0,
+        "fine_meas_every_ticks": 0,
+        "fine_correction": FINE_FEEDBACK,
+        "fine_gyro_arw": 0.0,
+        "fine_accel_vrw": 0.0,
+        "fine_sigma0_att_rad": np.zeros(3),
+        "fine_sigma0_gyro": 0.0,
+        "fine_sigma0_accel": 0.0,
     }
 
 
@@ -79,6 +102,23 @@ def config_resolved(cfg):
         cfg["coarse_output_every_ticks"] = DEFAULT_COARSE_EVERY_S * cfg["tick_hz"]
     if cfg["coarse_ratio"] == 0.0:
         cfg["coarse_ratio"] = DEFAULT_COARSE_RATIO
+    if cfg["fine_states"] == 0:
+        cfg["fine_states"] = DEFAULT_FINE_STATES
+    if cfg["fine_meas_every_ticks"] == 0:
+        cfg["fine_meas_every_ticks"] = DEFAULT_FINE_MEAS_EVERY
+    if cfg["fine_gyro_arw"] == 0.0:
+        cfg["fine_gyro_arw"] = DEFAULT_FINE_ARW
+    if cfg["fine_accel_vrw"] == 0.0:
+        cfg["fine_accel_vrw"] = DEFAULT_FINE_VRW
+    sig = np.array(cfg["fine_sigma0_att_rad"], dtype=float)
+    for i in range(3):
+        if sig[i] == 0.0:
+            sig[i] = DEFAULT_FINE_SIGMA_ATT[i]
+    cfg["fine_sigma0_att_rad"] = sig
+    if cfg["fine_sigma0_gyro"] == 0.0:
+        cfg["fine_sigma0_gyro"] = DEFAULT_FINE_SIGMA_GYRO
+    if cfg["fine_sigma0_accel"] == 0.0:
+        cfg["fine_sigma0_accel"] = DEFAULT_FINE_SIGMA_ACCEL
     return cfg
 
 
@@ -117,6 +157,16 @@ def config_check(raw):
             return PYINS_E_CONFIG_ALIGN_EARLY
         if cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1:
             return PYINS_E_CONFIG_ALIGN_LONG
+    if cfg["fine_ticks"] < 0:
+        return PYINS_E_CONFIG_ALIGN_TICKS
+    if (cfg["fine_states"] not in (5, 8) or cfg["fine_meas_every_ticks"] < 0
+            or cfg["fine_correction"] not in (FINE_FEEDBACK, FINE_OPEN_LOOP)):
+        return PYINS_E_CONFIG_FINE
+    noise = [cfg["fine_gyro_arw"], cfg["fine_accel_vrw"], *cfg["fine_sigma0_att_rad"],
+             cfg["fine_sigma0_gyro"], cfg["fine_sigma0_accel"]]
+    for v in noise:
+        if not (v > 0.0) or not math.isfinite(v):
+            return PYINS_E_CONFIG_NOISE
     return PYINS_OK
 
 
@@ -161,6 +211,9 @@ class Firmware:
         self.dt = 1.0 / float(cfg["tick_hz"])
         self.mode = MODE_IDLE
         self.att_valid = cfg["coarse_ticks"] == 0
+        self.kf_states = 0
+        self.faults = 0
+        self.fine = None
         self.tick = 0
         self.table_angle = cfg["table_angle_rad"]
         self.encoder = wrap_two_pi(cfg["table_angle_rad"])
@@ -192,7 +245,42 @@ class Firmware:
         self.sd = strapdown.make_strapdown(nav, self.sd.vertical)
         self.sd.hist = self.coarse.hist
         self.att_valid = True
+        if self.cfg["fine_ticks"] > 0:
+            self.start_fine()
+        else:
+            self.mode = MODE_NAVIGATE
+
+    def start_fine(self):
+        cfg = self.cfg
+        sin_lat, cos_lat = np.sin(cfg["lat_rad"]), np.cos(cfg["lat_rad"])
+        prm = fine_align.Params(
+            sin_lat=sin_lat, cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
+            dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
+            accel_vrw=cfg["fine_accel_vrw"], sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
+            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
+            feedback=cfg["fine_correction"] == FINE_FEEDBACK)
+        self.kf_states = cfg["fine_states"]
+        self.fine = fine_align.init(self.kf_states, prm)
+        self.mode = MODE_FINE_ALIGN
+
+    def fine_phi(self):
+        if self.mode != MODE_FINE_ALIGN:
+            return np.zeros(3)
+        return fine_align.phi(self.fine)
+
+    def end_fine(self):
+        phi = self.fine_phi()
+        self.sd.nav.quat_np = attitude.quat_normalize(
+            attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
+        fine_align.reset_phi(self.fine)
         self.mode = MODE_NAVIGATE
+
+    def hold_at_site(self):
+        self.sd.nav.lat = self.cfg["lat_rad"]
+        self.sd.nav.lon = self.sd.ref_lon
+        self.sd.nav.height = self.cfg["height_m"]
+        self.sd.nav.vel_n = np.zeros(3)
+        self.sd.prev_dvel_n = np.zeros(3)
 
     def step(self, dtheta_p, dv_p, table_angle_rad):
         """One tick; returns ``(status, output dict)``."""
@@ -201,11 +289,29 @@ class Firmware:
         dtheta_p = np.asarray(dtheta_p, dtype=float)
         dv_p = np.asarray(dv_p, dtype=float)
         if self.mode == MODE_IDLE:
-            self.mode = MODE_COARSE_ALIGN if self.cfg["coarse_ticks"] > 0 else MODE_NAVIGATE
+            if self.cfg["coarse_ticks"] > 0:
+                self.mode = MODE_COARSE_ALIGN
+            elif self.cfg["fine_ticks"] > 0:
+                self.start_fine()
+            else:
+                self.mode = MODE_NAVIGATE
         if self.mode == MODE_COARSE_ALIGN:
             coarse_align.update(self.coarse, dtheta_p, dv_p)
             if self.coarse.tick == self.cfg["coarse_ticks"]:
                 self.end_coarse()
+        elif self.mode == MODE_FINE_ALIGN:
+            dv_sf_n = strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
+            self.hold_at_site()
+            updated = fine_align.step(self.fine, dv_sf_n)
+            if not self.fine.healthy:
+                self.faults = self.faults | FAULT_KF_NOT_PD
+            if updated and self.cfg["fine_correction"] == FINE_FEEDBACK:
+                phi = self.fine_phi()
+                self.sd.nav.quat_np = attitude.quat_normalize(
+                    attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
+                fine_align.reset_phi(self.fine)
+            if self.tick + 1 == self.cfg["coarse_ticks"] + self.cfg["fine_ticks"]:
+                self.end_fine()
         else:
             strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
         encoder = wrap_two_pi(table_angle_rad)
@@ -225,12 +331,15 @@ class Firmware:
         if self.mode == MODE_COARSE_ALIGN and self.coarse.solved:
             q_np = attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse))
             valid = True
+        elif self.mode == MODE_FINE_ALIGN:
+            q_np = attitude.quat_normalize(
+                attitude.quat_mul(attitude.rotvec_to_quat(self.fine_phi()), nav.quat_np))
         q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
         return {
             "tick": self.tick,
             "mode": self.mode,
-            "fault_flags": 0,
+            "fault_flags": self.faults,
             "state_flags": STATE_ATT_VALID if valid else 0,
             "lat_rad": nav.lat,
             "lon_rad": nav.lon,
@@ -242,7 +351,17 @@ class Firmware:
             "heading_b_rad": attitude.yaw_to_heading(euler_b[2]),
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),
             "table_angle_rad": self.table_angle,
+            "kf_states": self.kf_states,
+            "kf_x": self._kf(lambda f: f.x),
+            "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
         }
+
+    def _kf(self, get):
+        out = np.zeros(8)
+        if self.fine is not None:
+            v = get(self.fine)
+            out[:len(v)] = v
+        return out
 
     def run(self, dtheta_p, dv_p, table_angle_rad):
         """Step through arrays; returns a list of output dicts (stops at a rejected sample)."""

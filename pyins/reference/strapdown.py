@@ -52,6 +52,7 @@ class Strapdown:
     prev_dvel_n: np.ndarray = field(default_factory=_zeros)
     vertical: int = VERTICAL_HOLD
     ref_height: float = 0.0
+    ref_lon: float = 0.0
 
 
 def compensate(dtheta, dv, h):
@@ -80,14 +81,17 @@ def make_strapdown(nav, vertical):
     s = Strapdown(nav=NavState(nav.lat, nav.lon, nav.height,
                                np.array(nav.vel_n, dtype=float),
                                np.array(nav.quat_np, dtype=float)),
-                  vertical=vertical, ref_height=nav.height)
+                  vertical=vertical, ref_height=nav.height, ref_lon=nav.lon)
     if vertical == VERTICAL_HOLD:
         s.nav.vel_n[2] = 0.0
     return s
 
 
 def update(s, dtheta_p, dv_p, dt):
-    """One update over a tick of ``dt`` seconds (mirrors ``strapdown::update``)."""
+    """One update over a tick of ``dt`` seconds (mirrors ``strapdown::update``).
+
+    Returns the tick's specific-force velocity increment in n [m/s].
+    """
     # 1. Coning, sculling and rotation compensation.
     phi, dv_comp = compensate(dtheta_p, dv_p, s.hist)
 
@@ -137,3 +141,4 @@ def update(s, dtheta_p, dv_p, dt):
     s.hist.dv1 = np.array(dv_p, dtype=float)
     if s.hist.count < 2:
         s.hist.count = s.hist.count + 1
+    return dv_sf_n

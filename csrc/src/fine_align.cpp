@@ -1,0 +1,106 @@
+// fine_align.cpp: see fine_align.hpp. Mirrored by pyins/reference/fine_align.py.
+#include "fine_align.hpp"
+
+#include "earth.hpp"
+
+namespace pyins::fine_align {
+
+template struct FineAlign<5>;
+template struct FineAlign<8>;
+
+template <int N>
+kalman::Mat<N, N> system_matrix(double sin_lat, double cos_lat) {
+    const double w_n = earth::kOmegaIe * cos_lat;
+    const double w_u = earth::kOmegaIe * sin_lat;
+    kalman::Mat<N, N> f = kalman::Mat<N, N>::Zero();
+    f(0, 1) = w_u;
+    f(0, 2) = -w_n;
+    f(1, 0) = -w_u;
+    f(2, 0) = w_n;
+    if constexpr (N == 8) {
+        f(0, 3) = -1.0;   // eps_E
+        f(1, 4) = -1.0;   // eps_N
+        f(2, 5) = -1.0;   // eps_U
+    } else {
+        f(1, 3) = -1.0;   // eps_N^
+        f(2, 4) = -1.0;   // eps_U^
+    }
+    return f;
+}
+
+template <int N>
+void init(FineAlign<N>& f, const Params& prm) {
+    const kalman::Mat<N, N> ft = system_matrix<N>(prm.sin_lat, prm.cos_lat) * prm.dt;
+    f.phi = kalman::Mat<N, N>::Identity() + ft + 0.5 * (ft * ft);
+    f.qd = kalman::Mat<N, N>::Zero();
+    const double q_att = prm.gyro_arw * prm.gyro_arw * prm.dt;
+    f.qd(0, 0) = q_att;
+    f.qd(1, 1) = q_att;
+    f.qd(2, 2) = q_att;
+
+    const double g = prm.gravity;
+    f.h = kalman::Mat<2, N>::Zero();
+    f.h(0, 1) = -g;
+    f.h(1, 0) = g;
+    if constexpr (N == 8) {
+        f.h(0, 6) = 1.0;  // nabla_E
+        f.h(1, 7) = 1.0;  // nabla_N
+    }
+    const double r = prm.accel_vrw * prm.accel_vrw / (static_cast<double>(prm.meas_every) * prm.dt);
+    f.r << r, 0.0,
+           0.0, r;
+
+    kalman::Vec<N> sigma;
+    sigma(0) = prm.sigma0_att[0];
+    sigma(1) = prm.sigma0_att[1];
+    sigma(2) = prm.sigma0_att[2];
+    if constexpr (N == 8) {
+        sigma(3) = prm.sigma0_gyro;
+        sigma(4) = prm.sigma0_gyro;
+        sigma(5) = prm.sigma0_gyro;
+        sigma(6) = prm.sigma0_accel;
+        sigma(7) = prm.sigma0_accel;
+    } else {
+        sigma(3) = prm.sigma0_gyro;
+        sigma(4) = prm.sigma0_gyro;
+    }
+    f.p = kalman::Mat<N, N>::Zero();
+    for (int i = 0; i < N; ++i) {
+        f.p(i, i) = sigma(i) * sigma(i);
+    }
+    f.x = kalman::Vec<N>::Zero();
+    f.dv_sum = Vec3::Zero();
+    f.meas_count = 0;
+    f.meas_every = prm.meas_every;
+    f.meas_span = static_cast<double>(prm.meas_every) * prm.dt;
+    f.feedback = prm.feedback;
+    f.healthy = true;
+}
+
+template <int N>
+bool step(FineAlign<N>& f, const Vec3& dv_sf_n) {
+    kalman::predict<N>(f.x, f.p, f.phi, f.qd);
+    f.dv_sum = f.dv_sum + dv_sf_n;
+    f.meas_count = f.meas_count + 1;
+    const bool updated = f.meas_count == f.meas_every;
+    if (updated) {
+        // z = mean specific force over the interval, E and N components.
+        kalman::Vec<2> z;
+        z(0) = f.dv_sum(0) / f.meas_span;
+        z(1) = f.dv_sum(1) / f.meas_span;
+        kalman::update2<N>(f.x, f.p, f.h, z, f.r);
+        f.dv_sum = Vec3::Zero();
+        f.meas_count = 0;
+    }
+    f.healthy = f.healthy && kalman::diagonal_positive<N>(f.p);
+    return updated;
+}
+
+template kalman::Mat<5, 5> system_matrix<5>(double, double);
+template kalman::Mat<8, 8> system_matrix<8>(double, double);
+template void init<5>(FineAlign<5>&, const Params&);
+template void init<8>(FineAlign<8>&, const Params&);
+template bool step<5>(FineAlign<5>&, const Vec3&);
+template bool step<8>(FineAlign<8>&, const Vec3&);
+
+}  // namespace pyins::fine_align

@@ -1,0 +1,96 @@
+// fine_align.hpp: static-base Kalman fine alignment (seed 001: Yan Gongmin,
+// Qin Yongyuan, Computer Simulation 2006, no. 10, p. 36), full 8-state and
+// reduced 5-state filters, for the IMU frame p.
+//
+// Mirrored by pyins/reference/fine_align.py.
+//
+// States (n = ENU, phi: C_p^n' = (I - phi x) C_p^n):
+//   8-state X = [phi_E phi_N phi_U eps_E eps_N eps_U nabla_E nabla_N]   (eq. 11)
+//   5-state X = [phi_E^ phi_N^ phi_U^ eps_N^ eps_U^]                     (eqs. 21-24)
+// Dynamics (eq. 10, static base):
+//   phi_E' =  w_U phi_N - w_N phi_U - eps_E,  phi_N' = -w_U phi_E - eps_N,
+//   phi_U' =  w_N phi_E - eps_U;  eps, nabla constant.
+// Measurement (eq. 15, with (15b)'s sign typo corrected as H and (23b) show):
+//   Z = [f_E f_N] of C_p^n' f^p = [-g phi_N + nabla_E, g phi_E + nabla_N] + v.
+// Discretisation: Phi = I + F T + (F T)^2 / 2 (F is constant on a static
+// base; the next term is < 1e-20 at T = 10 ms), Qd = diag(arw^2 T) on phi
+// (isotropic gyros: C Q^b C^T = arw^2 I). The measurement is the specific
+// force averaged over meas_every ticks, so R = vrw^2 / (meas_every T) I
+// (seed 001 prints R as a copy of Q: a typo; the accelerometer noise
+// projected into n is meant). P0 = diag(sigma0)^2 with seed 001's
+// sigma0 = 10 x [10', 10', 60', 0.001 deg/h, 0.001 deg/h] by default.
+// Feedback (recommended by the paper): after each update the attitude is
+// corrected by phi^ and phi^ reset to zero; open loop leaves the attitude
+// alone and reports the corrected one.
+#pragma once
+
+#include <cstdint>
+
+#include "kalman.hpp"
+#include "types.hpp"
+
+namespace pyins::fine_align {
+
+struct Params {
+    double sin_lat;
+    double cos_lat;
+    double gravity;          ///< [m/s^2]
+    double dt;               ///< tick [s]
+    int32_t meas_every;      ///< ticks per measurement
+    double gyro_arw;         ///< [rad/sqrt(s)]
+    double accel_vrw;        ///< [(m/s)/sqrt(s)]
+    double sigma0_att[3];    ///< [rad] E, N, U
+    double sigma0_gyro;      ///< [rad/s]
+    double sigma0_accel;     ///< [m/s^2] (8-state only)
+    bool feedback;
+};
+
+template <int N>
+struct FineAlign {
+    static_assert(N == 5 || N == 8, "the 5-state or the 8-state filter");
+    kalman::Vec<N> x;
+    kalman::Mat<N, N> p;
+    kalman::Mat<N, N> phi;
+    kalman::Mat<N, N> qd;
+    kalman::Mat<2, N> h;
+    kalman::Mat<2, 2> r;
+    Vec3 dv_sum;             ///< specific-force velocity increments in n' since the last update
+    int32_t meas_count;      ///< ticks in dv_sum
+    int32_t meas_every;
+    double meas_span;        ///< meas_every * dt [s]
+    bool feedback;
+    bool healthy;            ///< P positive definite (diagonal check) after every step
+};
+
+/// Continuous-time F of eq. 10 / eq. 23 for this filter.
+template <int N>
+kalman::Mat<N, N> system_matrix(double sin_lat, double cos_lat);
+
+template <int N>
+void init(FineAlign<N>& f, const Params& prm);
+
+/// One tick: time update, then a measurement update when meas_every ticks
+/// of specific force have been gathered. dv_sf_n: the tick's specific-force
+/// velocity increment projected into n' by the current attitude [m/s].
+/// Returns true when a measurement update happened.
+template <int N>
+bool step(FineAlign<N>& f, const Vec3& dv_sf_n);
+
+/// The attitude error estimate phi^ (E, N, U) [rad].
+template <int N>
+Vec3 phi(const FineAlign<N>& f) {
+    return Vec3(f.x(0), f.x(1), f.x(2));
+}
+
+/// After feeding phi^ back into the attitude: phi^ = 0.
+template <int N>
+void reset_phi(FineAlign<N>& f) {
+    f.x(0) = 0.0;
+    f.x(1) = 0.0;
+    f.x(2) = 0.0;
+}
+
+extern template struct FineAlign<5>;
+extern template struct FineAlign<8>;
+
+}  // namespace pyins::fine_align

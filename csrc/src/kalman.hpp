@@ -1,0 +1,58 @@
+// kalman.hpp: fixed-size linear Kalman filter steps (no heap).
+//
+// Mirrored by pyins/reference/kalman.py. Joseph-form update (Bucy & Joseph
+// 1968; Grewal & Andrews, "Kalman Filtering", 4th ed., eq. 4.25), symmetrised
+// after every step; positive definiteness is checked on the diagonal and
+// reported, never enforced silently.
+#pragma once
+
+#include <cmath>
+
+#include "types.hpp"
+
+namespace pyins::kalman {
+
+template <int N>
+using Vec = Eigen::Matrix<double, N, 1>;
+template <int R, int C>
+using Mat = Eigen::Matrix<double, R, C>;
+
+/// x <- Phi x;  P <- Phi P Phi^T + Qd, symmetrised.
+template <int N>
+void predict(Vec<N>& x, Mat<N, N>& p, const Mat<N, N>& phi, const Mat<N, N>& qd) {
+    x = phi * x;
+    const Mat<N, N> pp = phi * p * phi.transpose() + qd;
+    p = 0.5 * (pp + pp.transpose());
+}
+
+/// Measurement update with z = H x + v, v ~ N(0, R), Joseph form:
+///   K = P H^T (H P H^T + R)^-1,  x <- x + K (z - H x),
+///   P <- (I - K H) P (I - K H)^T + K R K^T, symmetrised.
+/// The innovation covariance is inverted in closed form for M = 2.
+template <int N>
+void update2(Vec<N>& x, Mat<N, N>& p, const Mat<2, N>& h, const Vec<2>& z, const Mat<2, 2>& r) {
+    const Mat<2, 2> s = h * p * h.transpose() + r;
+    const double det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
+    Mat<2, 2> s_inv;
+    s_inv << s(1, 1) / det, -s(0, 1) / det,
+             -s(1, 0) / det, s(0, 0) / det;
+    const Mat<N, 2> k = p * h.transpose() * s_inv;
+    x = x + k * (z - h * x);
+    const Mat<N, N> ikh = Mat<N, N>::Identity() - k * h;
+    const Mat<N, N> pj = ikh * p * ikh.transpose() + k * r * k.transpose();
+    p = 0.5 * (pj + pj.transpose());
+}
+
+/// True when every diagonal element is finite and positive.
+template <int N>
+bool diagonal_positive(const Mat<N, N>& p) {
+    for (int i = 0; i < N; ++i) {
+        const double d = p(i, i);
+        if (!(d > 0.0) || !std::isfinite(d)) {   // refuses NaN, <= 0 and Inf
+            return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace pyins::kalman

@@ -1,0 +1,110 @@
+"""Static-base Kalman fine alignment, 8-state and reduced 5-state (seed 001).
+
+Mirrors ``csrc/src/fine_align.{hpp,cpp}``; the header gives the model, the
+state layouts, the typo corrections and the defaults.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import earth, kalman
+
+
+@dataclass
+class Params:
+    sin_lat: float
+    cos_lat: float
+    gravity: float
+    dt: float
+    meas_every: int
+    gyro_arw: float
+    accel_vrw: float
+    sigma0_att: np.ndarray
+    sigma0_gyro: float
+    sigma0_accel: float
+    feedback: bool
+
+
+@dataclass
+class FineAlign:
+    n: int
+    x: np.ndarray
+    p: np.ndarray
+    phi: np.ndarray
+    qd: np.ndarray
+    h: np.ndarray
+    r: np.ndarray
+    dv_sum: np.ndarray
+    meas_count: int
+    meas_every: int
+    meas_span: float
+    feedback: bool
+    healthy: bool
+
+
+def system_matrix(n, sin_lat, cos_lat):
+    """F of seed 001 eq. 10 (n = 8) or eq. 23 (n = 5)."""
+    w_n = earth.OMEGA_IE * cos_lat
+    w_u = earth.OMEGA_IE * sin_lat
+    f = np.zeros((n, n))
+    f[0, 1] = w_u
+    f[0, 2] = -w_n
+    f[1, 0] = -w_u
+    f[2, 0] = w_n
+    if n == 8:
+        f[0, 3] = -1.0
+        f[1, 4] = -1.0
+        f[2, 5] = -1.0
+    else:
+        f[1, 3] = -1.0
+        f[2, 4] = -1.0
+    return f
+
+
+def init(n, prm):
+    ft = system_matrix(n, prm.sin_lat, prm.cos_lat) * prm.dt
+    phi = np.eye(n) + ft + 0.5 * (ft @ ft)
+    qd = np.zeros((n, n))
+    q_att = prm.gyro_arw * prm.gyro_arw * prm.dt
+    qd[0, 0] = qd[1, 1] = qd[2, 2] = q_att
+    g = prm.gravity
+    h = np.zeros((2, n))
+    h[0, 1] = -g
+    h[1, 0] = g
+    if n == 8:
+        h[0, 6] = 1.0
+        h[1, 7] = 1.0
+    r_val = prm.accel_vrw * prm.accel_vrw / (float(prm.meas_every) * prm.dt)
+    r = np.array([[r_val, 0.0], [0.0, r_val]])
+    if n == 8:
+        sigma = np.array([*prm.sigma0_att, prm.sigma0_gyro, prm.sigma0_gyro, prm.sigma0_gyro,
+                          prm.sigma0_accel, prm.sigma0_accel])
+    else:
+        sigma = np.array([*prm.sigma0_att, prm.sigma0_gyro, prm.sigma0_gyro])
+    p = np.diag(sigma * sigma)
+    return FineAlign(n=n, x=np.zeros(n), p=p, phi=phi, qd=qd, h=h, r=r, dv_sum=np.zeros(3),
+                     meas_count=0, meas_every=prm.meas_every,
+                     meas_span=float(prm.meas_every) * prm.dt, feedback=prm.feedback, healthy=True)
+
+
+def step(f, dv_sf_n):
+    """Time update, and a measurement update every meas_every ticks."""
+    f.x, f.p = kalman.predict(f.x, f.p, f.phi, f.qd)
+    f.dv_sum = f.dv_sum + dv_sf_n
+    f.meas_count = f.meas_count + 1
+    updated = f.meas_count == f.meas_every
+    if updated:
+        z = np.array([f.dv_sum[0] / f.meas_span, f.dv_sum[1] / f.meas_span])
+        f.x, f.p = kalman.update2(f.x, f.p, f.h, z, f.r)
+        f.dv_sum = np.zeros(3)
+        f.meas_count = 0
+    f.healthy = f.healthy and kalman.diagonal_positive(f.p)
+    return updated
+
+
+def phi(f):
+    return f.x[:3].copy()
+
+
+def reset_phi(f):
+    f.x[:3] = 0.0
