@@ -26,7 +26,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 3
+#define PYINS_ABI_VERSION_MINOR 4
 
 #ifdef __cplusplus
 extern "C" {
@@ -71,7 +71,8 @@ enum pyins_fine_correction {
 
 /* Bits of pyins_output.fault_flags (sticky). */
 enum pyins_fault_flag {
-    PYINS_FAULT_KF_NOT_PD = 1     /* the fine-alignment covariance lost positive definiteness */
+    PYINS_FAULT_KF_NOT_PD = 1,    /* the fine-alignment covariance lost positive definiteness */
+    PYINS_FAULT_ALIGN_RESTARTED = 2 /* a sample was rejected during alignment, which restarted */
 };
 
 /* Firmware modes, in pyins_output.mode. */
@@ -148,7 +149,7 @@ typedef struct pyins_output {
     double yaw_p_rad;             /* IMU yaw psi_p = psi_b + alpha, CCW, (-pi, pi] [rad] */
     double table_angle_rad;       /* unwrapped turntable angle alpha [rad] */
     int32_t kf_states;            /* 0 before fine alignment, else 5 or 8 (its last values stay) */
-    int32_t reserved1;
+    int32_t align_restarts;       /* alignments restarted after a rejected sample */
     double kf_x[8];               /* fine-alignment state, fine_align.hpp layout [rad, rad/s, m/s^2] */
     double kf_sigma[8];           /* its standard deviations, same units */
 } pyins_output;

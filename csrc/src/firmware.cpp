@@ -158,6 +158,9 @@ void Firmware::init(const pyins_config& raw) {
     mode_ = Mode::kIdle;
     att_valid_ = cfg.coarse_ticks == 0;
     kf_states_ = 0;
+    fine_tick_ = 0;
+    align_restarts_ = 0;
+    gap_pending_ = false;
     faults_ = 0u;
     tick_ = 0;
     table_angle_ = cfg.table_angle_rad;
@@ -224,6 +227,7 @@ void Firmware::start_fine() {
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
     prm.feedback = cfg_.fine_correction == PYINS_FINE_FEEDBACK;
     kf_states_ = cfg_.fine_states;
+    fine_tick_ = 0;
     if (kf_states_ == 8) {
         fine_align::init<8>(fine8_, prm);
     } else {
@@ -263,6 +267,13 @@ void Firmware::hold_at_site() {
 int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     if (!finite3(sample.dtheta_p_rad) || !finite3(sample.dv_p_mps) ||
         !std::isfinite(sample.table_angle_rad)) {
+        // Alignment cannot bridge a missing sample on a moving base (the
+        // rotation over it is lost): it restarts at the next good sample.
+        // Navigation only reports the rejection; its state is untouched.
+        if (mode_ == Mode::kCoarseAlign || mode_ == Mode::kFineAlign) {
+            gap_pending_ = true;
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_RESTARTED);
+        }
         if (out != nullptr) {
             output(out);
         }
@@ -270,6 +281,17 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     }
     const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
     const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
+    if (gap_pending_) {
+        gap_pending_ = false;
+        align_restarts_ = align_restarts_ + 1;
+        if (cfg_.coarse_ticks > 0) {
+            coarse_align::init(coarse_, coarse_.prm);
+            att_valid_ = false;
+            mode_ = Mode::kCoarseAlign;
+        } else {
+            start_fine();
+        }
+    }
     if (mode_ == Mode::kIdle) {
         if (cfg_.coarse_ticks > 0) {
             mode_ = Mode::kCoarseAlign;
@@ -310,7 +332,8 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
                 fine_align::reset_phi<5>(fine5_);
             }
         }
-        if (tick_ + 1 == static_cast<int64_t>(cfg_.coarse_ticks) + cfg_.fine_ticks) {
+        fine_tick_ = fine_tick_ + 1;
+        if (fine_tick_ == cfg_.fine_ticks) {
             end_fine();
         }
     } else {
@@ -375,7 +398,7 @@ void Firmware::output(pyins_output* out) const {
     out->yaw_p_rad = wrap_pi(euler_b(2) + encoder_);
     out->table_angle_rad = table_angle_;
     out->kf_states = kf_states_;
-    out->reserved1 = 0;
+    out->align_restarts = align_restarts_;
     for (int i = 0; i < 8; ++i) {
         out->kf_x[i] = 0.0;
         out->kf_sigma[i] = 0.0;

@@ -84,6 +84,9 @@ class Firmware {
     fine_align::FineAlign<5> fine5_;
     fine_align::FineAlign<8> fine8_;
     int32_t kf_states_;           ///< 0 until fine alignment starts, then 5 or 8
+    int32_t fine_tick_;           ///< samples taken in fine alignment
+    int32_t align_restarts_;      ///< alignments restarted after a rejected sample
+    bool gap_pending_;            ///< a sample was rejected during alignment
     uint32_t faults_;             ///< sticky pyins_fault_flag bits
     bool att_valid_;              ///< attitude is a solution (not the configured guess)
     double table_angle_;          ///< unwrapped turntable angle alpha [rad]

@@ -36,6 +36,7 @@ PYINS_E_CONFIG_NOISE = -22
 FINE_FEEDBACK = 0      #: PYINS_FINE_FEEDBACK
 FINE_OPEN_LOOP = 1     #: PYINS_FINE_OPEN_LOOP
 FAULT_KF_NOT_PD = 1    #: PYINS_FAULT_KF_NOT_PD
+FAULT_ALIGN_RESTARTED = 2  #: PYINS_FAULT_ALIGN_RESTARTED
 
 MODE_IDLE = 0          #: Mode::kIdle
 MODE_COARSE_ALIGN = 1  #: Mode::kCoarseAlign
@@ -212,6 +213,9 @@ class Firmware:
         self.mode = MODE_IDLE
         self.att_valid = cfg["coarse_ticks"] == 0
         self.kf_states = 0
+        self.fine_tick = 0
+        self.align_restarts = 0
+        self.gap_pending = False
         self.faults = 0
         self.fine = None
         self.tick = 0
@@ -260,6 +264,7 @@ class Firmware:
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
             feedback=cfg["fine_correction"] == FINE_FEEDBACK)
         self.kf_states = cfg["fine_states"]
+        self.fine_tick = 0
         self.fine = fine_align.init(self.kf_states, prm)
         self.mode = MODE_FINE_ALIGN
 
@@ -285,9 +290,21 @@ class Firmware:
     def step(self, dtheta_p, dv_p, table_angle_rad):
         """One tick; returns ``(status, output dict)``."""
         if not (_finite3(dtheta_p) and _finite3(dv_p) and math.isfinite(table_angle_rad)):
+            if self.mode in (MODE_COARSE_ALIGN, MODE_FINE_ALIGN):
+                self.gap_pending = True
+                self.faults = self.faults | FAULT_ALIGN_RESTARTED
             return PYINS_E_SAMPLE_NONFINITE, self.output()
         dtheta_p = np.asarray(dtheta_p, dtype=float)
         dv_p = np.asarray(dv_p, dtype=float)
+        if self.gap_pending:
+            self.gap_pending = False
+            self.align_restarts = self.align_restarts + 1
+            if self.cfg["coarse_ticks"] > 0:
+                self.coarse = coarse_align.init(self.coarse.prm)
+                self.att_valid = False
+                self.mode = MODE_COARSE_ALIGN
+            else:
+                self.start_fine()
         if self.mode == MODE_IDLE:
             if self.cfg["coarse_ticks"] > 0:
                 self.mode = MODE_COARSE_ALIGN
@@ -310,7 +327,8 @@ class Firmware:
                 self.sd.nav.quat_np = attitude.quat_normalize(
                     attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
                 fine_align.reset_phi(self.fine)
-            if self.tick + 1 == self.cfg["coarse_ticks"] + self.cfg["fine_ticks"]:
+            self.fine_tick = self.fine_tick + 1
+            if self.fine_tick == self.cfg["fine_ticks"]:
                 self.end_fine()
         else:
             strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
@@ -352,6 +370,7 @@ class Firmware:
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),
             "table_angle_rad": self.table_angle,
             "kf_states": self.kf_states,
+            "align_restarts": self.align_restarts,
             "kf_x": self._kf(lambda f: f.x),
             "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
         }

@@ -69,7 +69,8 @@ int main(void) {
                              PYINS_E_CONFIG_LAT, PYINS_E_CONFIG_LON, PYINS_E_CONFIG_HEIGHT,
                              PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE,
                              PYINS_E_CONFIG_ALIGN_RATIO, PYINS_E_CONFIG_ALIGN_EARLY,
-                             PYINS_E_CONFIG_ALIGN_LONG, PYINS_E_CONFIG_ALIGN_TICKS};
+                             PYINS_E_CONFIG_ALIGN_LONG, PYINS_E_CONFIG_ALIGN_TICKS,
+                             PYINS_E_CONFIG_FINE, PYINS_E_CONFIG_NOISE};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
         int distinct = 1;
@@ -131,6 +132,13 @@ int main(void) {
     BAD_CFG(b.coarse_ticks = -1, PYINS_E_CONFIG_ALIGN_TICKS, "negative coarse duration");
     BAD_CFG((b.coarse_ticks = 1000, b.coarse_first_output_ticks = 2000), PYINS_E_CONFIG_ALIGN_TICKS,
             "first output after the end");
+    BAD_CFG(b.fine_ticks = -5, PYINS_E_CONFIG_ALIGN_TICKS, "negative fine duration");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_states = 6), PYINS_E_CONFIG_FINE, "fine_states 6");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_meas_every_ticks = -1), PYINS_E_CONFIG_FINE, "negative update interval");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_correction = 3), PYINS_E_CONFIG_FINE, "unknown correction");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_gyro_arw = -1e-6), PYINS_E_CONFIG_NOISE, "negative gyro ARW");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_accel_vrw = NAN), PYINS_E_CONFIG_NOISE, "NaN accel VRW");
+    BAD_CFG((b.fine_ticks = 1000, b.fine_sigma0_att_rad[2] = -1.0), PYINS_E_CONFIG_NOISE, "negative sigma0");
 
     /* init: NULL, misaligned, too small. */
     check_status(pyins_init(NULL, size, &cfg), PYINS_E_NULL, "init NULL mem");

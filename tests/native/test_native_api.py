@@ -32,10 +32,15 @@ def test_layout_matches_library():
     ("vel_n_mps", [0.0, float("nan"), 0.0], "PYINS_E_CONFIG_VEL"),
     ("euler_b_rad", [0.0, 0.0, float("inf")], "PYINS_E_CONFIG_ATT"),
     ("vertical_mode", 5, "PYINS_E_CONFIG_MODE"),
+    ({"coarse_ticks": 15000, "coarse_ratio": 1.2}, None, "PYINS_E_CONFIG_ALIGN_RATIO"),
+    ({"coarse_ticks": 15000, "coarse_first_output_ticks": 100}, None, "PYINS_E_CONFIG_ALIGN_EARLY"),
+    ({"coarse_ticks": 60000}, None, "PYINS_E_CONFIG_ALIGN_LONG"),
+    ({"fine_ticks": 1000, "fine_states": 7}, None, "PYINS_E_CONFIG_FINE"),
+    ({"fine_ticks": 1000, "fine_gyro_arw": -1e-7}, None, "PYINS_E_CONFIG_NOISE"),
 ])
 def test_config_errors_are_distinct_and_named(field, value, status):
     with pytest.raises(native.ConfigError) as info:
-        native.Firmware(**{field: value})
+        native.Firmware(**(field if isinstance(field, dict) else {field: value}))
     assert info.value.status_name == status
     assert isinstance(info.value, ValueError)
 

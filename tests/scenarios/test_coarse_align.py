@@ -85,3 +85,36 @@ def test_biased_alignment_near_theoretical_limit(state, seconds, level_arcsec, h
             worst = np.maximum(worst, [np.abs(d[:2]).max() / ARCSEC, abs(d[2]) / ARCMIN])
     print(f"{state}: max |error - limit| level {worst[0]:.3f} arcsec, heading {worst[1]:.3f} arcmin")
     assert worst[0] < level_arcsec and worst[1] < heading_arcmin
+
+
+@pytest.mark.parametrize("bad_tick", [5000, 22000])
+def test_rejected_sample_during_alignment_restarts_it(bad_tick):
+    """A NaN sample during coarse (tick 5000) or fine (tick 22000) alignment on
+    the bad sea state: the rotation over it is lost, so the alignment reports
+    the gap (sticky fault bit, restart counter) and starts again; it then
+    finishes with the same accuracy as without the gap."""
+    from pyins import native
+    m = motion("bad", 240)
+    coarse, fine = 20000, 6000
+    n = 2 * (coarse + fine) + 100
+    dtheta, dv, alpha = sim.exact_increments(m, n)
+    cfg = runner.initial_config(m, None, coarse_ticks=coarse, fine_ticks=fine, euler_b_rad=[0.0, 0.0, 0.0])
+    fw = native.Firmware(cfg)
+    s = native.make_samples(dtheta, dv, alpha)
+    first = fw.run(s[:bad_tick])
+    bad = s[bad_tick:bad_tick + 1].copy()
+    bad["dtheta_p_rad"][0, 0] = np.nan
+    with pytest.raises(native.SampleError):
+        fw.run(bad)
+    rest = fw.run(s[bad_tick + 1:])
+    out = np.concatenate([first, rest])
+    assert rest[0]["align_restarts"] == 1 and rest[0]["fault_flags"] & 2
+    assert rest[0]["mode"] == 1                       # back in coarse alignment
+    modes = out["mode"]
+    nav_start = int(np.argmax(modes == 3))
+    assert nav_start == bad_tick + coarse + fine - 1  # a full alignment after the gap
+    # accuracy at the end of the repeated alignment: the error-free bounds
+    truth = sim.truth_at(m, np.array([nav_start + 2]))   # sample number of that record
+    q_err = attitude.quat_mul(out[nav_start]["quat_nb"], attitude.quat_conj(truth.quat_nb[0]))
+    err = np.abs(attitude.quat_to_rotvec(attitude.quat_normalize(q_err)))
+    assert err[:2].max() < 2.0 * ARCSEC and err[2] < 0.5 * ARCMIN
