@@ -1,7 +1,8 @@
 /* bench_step.c: drive the firmware for instruction counting.
- *   valgrind --tool=callgrind --toggle-collect=pyins_step ./bench_step 10000
+ *   valgrind --tool=callgrind --toggle-collect=pyins_step ./bench_step 10000 [MODE]
  * counts the instructions inside pyins_step only (repeatable, unlike time).
- * tools/bench_strapdown.py runs this and prints Ir per step. */
+ * MODE: nav (default), coarse, fine5, fine8: every step in that mode.
+ * tools/bench_strapdown.py and tools/bench_alignment.py run this. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,7 @@
 
 int main(int argc, char **argv) {
     const long n = argc > 1 ? atol(argv[1]) : 10000;
+    const char *mode = argc > 2 ? argv[2] : "nav";
     static unsigned char mem[1 << 14] __attribute__((aligned(64)));
     pyins_config cfg;
     pyins_sample s;
@@ -24,6 +26,16 @@ int main(int argc, char **argv) {
     cfg.euler_b_rad[0] = 0.02;
     cfg.euler_b_rad[1] = -0.03;
     cfg.euler_b_rad[2] = 1.0;
+    if (strcmp(mode, "coarse") == 0) {
+        cfg.coarse_ticks = 25500;           /* the longest the storage allows at 1 s outputs */
+        if (n > cfg.coarse_ticks) return 5;
+    } else if (strcmp(mode, "fine5") == 0 || strcmp(mode, "fine8") == 0) {
+        cfg.fine_ticks = (int32_t)n + 1;
+        cfg.fine_states = mode[4] == '8' ? 8 : 5;
+    } else if (strcmp(mode, "nav") != 0) {
+        fprintf(stderr, "unknown mode %s\n", mode);
+        return 2;
+    }
     if (pyins_init(mem, sizeof mem, &cfg) != PYINS_OK) return 3;
     memset(&s, 0, sizeof s);
     for (i = 0; i < n; ++i) {
