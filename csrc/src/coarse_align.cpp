@@ -82,13 +82,7 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p) {
     a.vel_ib0 = a.vel_ib0 + attitude::quat_to_mat(a.quat_ib0_p) * c.dv_p;
     a.quat_ib0_p = attitude::quat_normalize(
         attitude::quat_mul(a.quat_ib0_p, attitude::rotvec_to_quat(c.phi)));
-    a.hist.dtheta2 = a.hist.dtheta1;
-    a.hist.dv2 = a.hist.dv1;
-    a.hist.dtheta1 = dtheta_p;
-    a.hist.dv1 = dv_p;
-    if (a.hist.count < 2) {
-        a.hist.count = a.hist.count + 1;
-    }
+    strapdown::push_history(a.hist, dtheta_p, dv_p);
     a.tick = a.tick + 1;
 
     const int64_t every = a.prm.output_every;

@@ -243,8 +243,9 @@ Vec3 Firmware::fine_phi() const {
     return kf_states_ == 8 ? fine_align::phi<8>(fine8_) : fine_align::phi<5>(fine5_);
 }
 
-void Firmware::end_fine() {
-    // Navigation starts from the corrected attitude (both correction modes).
+void Firmware::apply_fine_correction() {
+    // C_p^n = (I + phi x) C_p^n': rotate the attitude by phi^ in n, then
+    // phi^ = 0 (the error it described is gone).
     const Vec3 phi = fine_phi();
     sd_.nav.quat_np = attitude::quat_normalize(
         attitude::quat_mul(attitude::rotvec_to_quat(phi), sd_.nav.quat_np));
@@ -253,6 +254,11 @@ void Firmware::end_fine() {
     } else {
         fine_align::reset_phi<5>(fine5_);
     }
+}
+
+void Firmware::end_fine() {
+    // Navigation starts from the corrected attitude (both correction modes).
+    apply_fine_correction();
     mode_ = Mode::kNavigate;
 }
 
@@ -323,14 +329,7 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
             faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
         }
         if (updated && cfg_.fine_correction == PYINS_FINE_FEEDBACK) {
-            const Vec3 phi = fine_phi();
-            sd_.nav.quat_np = attitude::quat_normalize(
-                attitude::quat_mul(attitude::rotvec_to_quat(phi), sd_.nav.quat_np));
-            if (kf_states_ == 8) {
-                fine_align::reset_phi<8>(fine8_);
-            } else {
-                fine_align::reset_phi<5>(fine5_);
-            }
+            apply_fine_correction();
         }
         fine_tick_ = fine_tick_ + 1;
         if (fine_tick_ == cfg_.fine_ticks) {

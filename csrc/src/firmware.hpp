@@ -69,6 +69,8 @@ class Firmware {
     /// Start / leave fine alignment.
     void start_fine();
     void end_fine();
+    /// Correct the attitude by the fine filter's phi^ and reset phi^.
+    void apply_fine_correction();
     /// The fine filter's attitude estimate phi^ [rad] (zero outside it).
     Vec3 fine_phi() const;
     /// Hold the static-base assumption of the alignment: site, at rest.

@@ -29,6 +29,16 @@ Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h) {
     return c;
 }
 
+void push_history(History& h, const Vec3& dtheta, const Vec3& dv) {
+    h.dtheta2 = h.dtheta1;
+    h.dv2 = h.dv1;
+    h.dtheta1 = dtheta;
+    h.dv1 = dv;
+    if (h.count < 2) {
+        h.count = h.count + 1;
+    }
+}
+
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     Strapdown s;
     s.nav = nav;
@@ -99,13 +109,7 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     // 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n;
     s.nav.vel_n = vel_new;
-    s.hist.dtheta2 = s.hist.dtheta1;
-    s.hist.dv2 = s.hist.dv1;
-    s.hist.dtheta1 = dtheta_p;
-    s.hist.dv1 = dv_p;
-    if (s.hist.count < 2) {
-        s.hist.count = s.hist.count + 1;
-    }
+    push_history(s.hist, dtheta_p, dv_p);
     return dv_sf_n;
 }
 

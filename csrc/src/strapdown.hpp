@@ -81,6 +81,9 @@ struct Compensated {
 /// for 1 tick: cone = th1*th / 12, scul = (th1*dv + dv1*th) / 12; for none: 0.
 Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h);
 
+/// Shift this tick's increments into the history.
+void push_history(History& h, const Vec3& dtheta, const Vec3& dv);
+
 /// Start a strapdown at a navigation state.
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);
 

@@ -84,12 +84,7 @@ def update(a, dtheta_p, dv_p):
     a.vel_ib0 = a.vel_ib0 + attitude.quat_to_mat(a.quat_ib0_p) @ dv_comp
     a.quat_ib0_p = attitude.quat_normalize(
         attitude.quat_mul(a.quat_ib0_p, attitude.rotvec_to_quat(phi)))
-    a.hist.dtheta2 = a.hist.dtheta1
-    a.hist.dv2 = a.hist.dv1
-    a.hist.dtheta1 = np.array(dtheta_p, dtype=float)
-    a.hist.dv1 = np.array(dv_p, dtype=float)
-    if a.hist.count < 2:
-        a.hist.count = a.hist.count + 1
+    strapdown.push_history(a.hist, dtheta_p, dv_p)
     a.tick = a.tick + 1
 
     every = a.prm.output_every

@@ -273,11 +273,15 @@ class Firmware:
             return np.zeros(3)
         return fine_align.phi(self.fine)
 
-    def end_fine(self):
+    def apply_fine_correction(self):
+        """C_p^n = (I + phi x) C_p^n': rotate by phi^ in n, then phi^ = 0."""
         phi = self.fine_phi()
         self.sd.nav.quat_np = attitude.quat_normalize(
             attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
         fine_align.reset_phi(self.fine)
+
+    def end_fine(self):
+        self.apply_fine_correction()
         self.mode = MODE_NAVIGATE
 
     def hold_at_site(self):
@@ -323,10 +327,7 @@ class Firmware:
             if not self.fine.healthy:
                 self.faults = self.faults | FAULT_KF_NOT_PD
             if updated and self.cfg["fine_correction"] == FINE_FEEDBACK:
-                phi = self.fine_phi()
-                self.sd.nav.quat_np = attitude.quat_normalize(
-                    attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
-                fine_align.reset_phi(self.fine)
+                self.apply_fine_correction()
             self.fine_tick = self.fine_tick + 1
             if self.fine_tick == self.cfg["fine_ticks"]:
                 self.end_fine()

@@ -77,6 +77,16 @@ def compensate(dtheta, dv, h):
     return phi, dv_p
 
 
+def push_history(h, dtheta, dv):
+    """Shift this tick's increments into the history (mirrors push_history)."""
+    h.dtheta2 = h.dtheta1
+    h.dv2 = h.dv1
+    h.dtheta1 = np.array(dtheta, dtype=float)
+    h.dv1 = np.array(dv, dtype=float)
+    if h.count < 2:
+        h.count = h.count + 1
+
+
 def make_strapdown(nav, vertical):
     s = Strapdown(nav=NavState(nav.lat, nav.lon, nav.height,
                                np.array(nav.vel_n, dtype=float),
@@ -135,10 +145,5 @@ def update(s, dtheta_p, dv_p, dt):
     # 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n
     s.nav.vel_n = vel_new
-    s.hist.dtheta2 = s.hist.dtheta1
-    s.hist.dv2 = s.hist.dv1
-    s.hist.dtheta1 = np.array(dtheta_p, dtype=float)
-    s.hist.dv1 = np.array(dv_p, dtype=float)
-    if s.hist.count < 2:
-        s.hist.count = s.hist.count + 1
+    push_history(s.hist, dtheta_p, dv_p)
     return dv_sf_n
