@@ -37,6 +37,15 @@ typedef struct pyins_t_strapdown {
     double ref_height;
 } pyins_t_strapdown;
 
+typedef struct pyins_t_fine_params {
+    double sin_lat, cos_lat, gravity, dt;
+    int32_t meas_every;
+    int32_t feedback;
+    double gyro_arw, accel_vrw;
+    double sigma0_att[3];
+    double sigma0_gyro, sigma0_accel;
+} pyins_t_fine_params;
+
 /* math_portable */
 double pyins_t_sin(double x);
 double pyins_t_cos(double x);
@@ -74,6 +83,12 @@ void pyins_t_compensate(const double dtheta[3], const double dv[3],
                         double phi[3], double dv_p[3]);
 void pyins_t_strapdown_update(pyins_t_strapdown *s, const double dtheta_p[3],
                               const double dv_p[3], double dt);
+
+/* fine_align: init, then n steps on the specific-force increments
+ * dv_sf_n[3 n]; writes x (states values) and P (states x states, row-major).
+ * Returns 0, or -1 if states is not 5 or 8. */
+int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params *prm, const double *dv_sf_n,
+                           size_t n, double *x_out, double *p_out);
 
 /* CDEF-END */
 

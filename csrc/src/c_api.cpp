@@ -221,11 +221,28 @@ const char* pyins_status_str(int status) {
 #include "earth.hpp"
 #include "math_portable.hpp"
 #include "pyins_core_testing.h"
+#include "fine_align.hpp"
 #include "strapdown.hpp"
 
 namespace {
 
 using pyins::Mat3;
+
+template <int N>
+void fine_run(const pyins::fine_align::Params& prm, const double* dv, size_t n, double* x_out,
+              double* p_out) {
+    pyins::fine_align::FineAlign<N> f;
+    pyins::fine_align::init<N>(f, prm);
+    for (size_t k = 0; k < n; ++k) {
+        pyins::fine_align::step<N>(f, pyins::Vec3(dv[3 * k], dv[3 * k + 1], dv[3 * k + 2]));
+    }
+    for (int i = 0; i < N; ++i) {
+        x_out[i] = f.x(i);
+        for (int j = 0; j < N; ++j) {
+            p_out[N * i + j] = f.p(i, j);
+        }
+    }
+}
 using pyins::Quat;
 using pyins::Vec3;
 
@@ -365,6 +382,32 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     put3(sd.hist.dv2, s->dv2);
     s->hist_count = sd.hist.count;
     put3(sd.prev_dvel_n, s->prev_dvel_n);
+}
+
+int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params* p, const double* dv_sf_n,
+                           size_t n, double* x_out, double* p_out) {
+    pyins::fine_align::Params prm;
+    prm.sin_lat = p->sin_lat;
+    prm.cos_lat = p->cos_lat;
+    prm.gravity = p->gravity;
+    prm.dt = p->dt;
+    prm.meas_every = p->meas_every;
+    prm.gyro_arw = p->gyro_arw;
+    prm.accel_vrw = p->accel_vrw;
+    prm.sigma0_att[0] = p->sigma0_att[0];
+    prm.sigma0_att[1] = p->sigma0_att[1];
+    prm.sigma0_att[2] = p->sigma0_att[2];
+    prm.sigma0_gyro = p->sigma0_gyro;
+    prm.sigma0_accel = p->sigma0_accel;
+    prm.feedback = p->feedback != 0;
+    if (states == 5) {
+        fine_run<5>(prm, dv_sf_n, n, x_out, p_out);
+    } else if (states == 8) {
+        fine_run<8>(prm, dv_sf_n, n, x_out, p_out);
+    } else {
+        return -1;
+    }
+    return 0;
 }
 
 }  // extern "C"

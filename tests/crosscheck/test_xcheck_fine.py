@@ -55,3 +55,40 @@ def test_alignment_cpp_equals_reference(sc):
         # difference of large terms) is held to 1e-9 of its own sigma instead
         assert rel_close(c["kf_sigma"], r["kf_sigma"], 1e-9, 1e-300), k
         assert rel_close(c["kf_x"], r["kf_x"], 1e-9, r["kf_sigma"]), k
+
+
+@settings(max_examples=30, deadline=None)
+@given(states=st.sampled_from([5, 8]), lat=st.floats(-80.0, 80.0), meas_every=st.integers(1, 20),
+       n=st.integers(1, 400), arw=st.floats(1e-7, 1e-4), vrw=st.floats(1e-6, 1e-3),
+       tilt=st.tuples(st.floats(-1e-2, 1e-2), st.floats(-1e-2, 1e-2)), seed=st.integers(0, 99))
+def test_fine_filter_module_state_and_full_covariance(states, lat, meas_every, n, arw, vrw, tilt, seed):
+    """The fine-alignment module alone (init + n steps): state within 1e-9
+    relative (floor: 1e-9 of its sigma) and every covariance element within
+    1e-9 of sqrt(P_ii P_jj), the scale of that element."""
+    from pyins.reference import fine_align
+    import hooks
+
+    lat = lat * DEG
+    g = earth.normal_gravity(np.sin(lat), 0.0)
+    rng = np.random.default_rng(seed)
+    dv = np.tile([-g * tilt[1], g * tilt[0], g], (n, 1)) * 0.01 + vrw * 0.1 * rng.standard_normal((n, 3))
+    prm = fine_align.Params(np.sin(lat), np.cos(lat), g, 0.01, meas_every, arw, vrw,
+                            np.array([3e-3, 3e-3, 2e-2]), 5e-8, 1e-3, True)
+    f = fine_align.init(states, prm)
+    for k in range(n):
+        fine_align.step(f, dv[k])
+    cp = hooks.ffi.new("pyins_t_fine_params *")
+    cp.sin_lat, cp.cos_lat, cp.gravity, cp.dt = prm.sin_lat, prm.cos_lat, g, 0.01
+    cp.meas_every, cp.feedback, cp.gyro_arw, cp.accel_vrw = meas_every, 1, arw, vrw
+    for i in range(3):
+        cp.sigma0_att[i] = prm.sigma0_att[i]
+    cp.sigma0_gyro, cp.sigma0_accel = prm.sigma0_gyro, prm.sigma0_accel
+    x = hooks.ffi.new("double[8]")
+    p = hooks.ffi.new("double[64]")
+    dv_c = np.ascontiguousarray(dv)
+    assert hooks.lib.pyins_t_fine_align_run(states, cp, hooks.ffi.from_buffer("double[]", dv_c), n, x, p) == 0
+    xc = np.array(list(x))[:states]
+    pc = np.array(list(p))[:states * states].reshape(states, states)
+    sig = np.sqrt(np.diag(f.p))
+    assert np.all(np.abs(xc - f.x) <= 1e-9 * np.maximum(np.abs(f.x), sig))
+    assert np.all(np.abs(pc - f.p) <= 1e-9 * np.outer(sig, sig))
