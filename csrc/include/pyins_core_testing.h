@@ -46,6 +46,20 @@ typedef struct pyins_t_fine_params {
     double sigma0_gyro, sigma0_accel;
 } pyins_t_fine_params;
 
+typedef struct pyins_t_index_params {
+    int32_t stop_ticks[8];
+    int32_t kind[8];
+    double angle[8];
+    int32_t n_steps;
+    int32_t timeout_ticks;
+    double rate, accel, delta, max_flex, tolerance, jump, dt;
+} pyins_t_index_params;
+
+typedef struct pyins_t_index_out {
+    int32_t state, step, fault, fallbacks;
+    double cmd_angle, cmd_rate, a_c, a_s;
+} pyins_t_index_out;
+
 /* math_portable */
 double pyins_t_sin(double x);
 double pyins_t_cos(double x);
@@ -89,6 +103,16 @@ void pyins_t_strapdown_update(pyins_t_strapdown *s, const double dtheta_p[3],
  * Returns 0, or -1 if states is not 5 or 8. */
 int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params *prm, const double *dv_sf_n,
                            size_t n, double *x_out, double *p_out);
+
+/* indexing: init at meas0, then n ticks. meas[k] is the unwrapped encoder
+ * angle of tick k, or with meas == NULL an ideal table that is where it was
+ * commanded one tick before. The IMU yaw given to the machine is
+ * yaw_b[k] + meas (ship yaw plus table angle). */
+void pyins_t_indexing_run(const pyins_t_index_params *prm, double meas0, const double *meas,
+                          const double *yaw_b, size_t n, pyins_t_index_out *out);
+/* The steps of a preset scheme (enum pyins_index_scheme) with the given stop
+ * length; returns the number of steps (0..8), or -1 for an unknown scheme. */
+int32_t pyins_t_index_preset(int32_t scheme, int32_t stop_ticks, pyins_t_index_params *out);
 
 /* CDEF-END */
 

@@ -222,6 +222,7 @@ const char* pyins_status_str(int status) {
 #include "math_portable.hpp"
 #include "pyins_core_testing.h"
 #include "fine_align.hpp"
+#include "indexing.hpp"
 #include "strapdown.hpp"
 
 namespace {
@@ -408,6 +409,51 @@ int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params* p, const d
         return -1;
     }
     return 0;
+}
+
+void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const double* meas,
+                          const double* yaw_b, size_t n, pyins_t_index_out* out) {
+    pyins::indexing::Params prm;
+    prm.n_steps = p->n_steps;
+    for (int i = 0; i < pyins::indexing::kMaxSteps; ++i) {
+        prm.steps[i].stop_ticks = p->stop_ticks[i];
+        prm.steps[i].kind = static_cast<pyins::indexing::Kind>(p->kind[i]);
+        prm.steps[i].angle = p->angle[i];
+    }
+    prm.rate = p->rate;
+    prm.accel = p->accel;
+    prm.delta = p->delta;
+    prm.max_flex = p->max_flex;
+    prm.tolerance = p->tolerance;
+    prm.jump = p->jump;
+    prm.timeout_ticks = p->timeout_ticks;
+    prm.dt = p->dt;
+    pyins::indexing::Indexer ix;
+    pyins::indexing::init(ix, prm, meas0);
+    for (size_t k = 0; k < n; ++k) {
+        const double m = meas != nullptr ? meas[k] : ix.cmd_angle;
+        pyins::indexing::update(ix, m, yaw_b[k] + m);
+        out[k].state = static_cast<int32_t>(ix.state);
+        out[k].step = ix.step;
+        out[k].fault = static_cast<int32_t>(ix.fault);
+        out[k].fallbacks = ix.fallbacks;
+        out[k].cmd_angle = ix.cmd_angle;
+        out[k].cmd_rate = ix.cmd_rate;
+        out[k].a_c = ix.a_c;
+        out[k].a_s = ix.a_s;
+    }
+}
+
+int32_t pyins_t_index_preset(int32_t scheme, int32_t stop_ticks, pyins_t_index_params* out) {
+    pyins::indexing::Step steps[pyins::indexing::kMaxSteps];
+    const int32_t n = pyins::indexing::preset_steps(scheme, stop_ticks, steps);
+    for (int32_t i = 0; i < n; ++i) {
+        out->stop_ticks[i] = steps[i].stop_ticks;
+        out->kind[i] = static_cast<int32_t>(steps[i].kind);
+        out->angle[i] = steps[i].angle;
+    }
+    out->n_steps = n < 0 ? 0 : n;
+    return n;
 }
 
 }  // extern "C"

@@ -1,0 +1,206 @@
+// indexing.cpp: see indexing.hpp. Mirrored by pyins/reference/indexing.py.
+#include "indexing.hpp"
+
+#include <cmath>
+
+#include "math_portable.hpp"
+
+namespace pyins::indexing {
+
+namespace {
+
+double sense(double angle) { return angle < 0.0 ? -1.0 : 1.0; }
+
+void start_stop(Indexer& ix) {
+    ix.state = State::kStop;
+    ix.stop_count = 0;
+    ix.cmd_rate = 0.0;
+    ix.lag_ticks = 0;
+}
+
+void start_move(Indexer& ix) {
+    const Step& s = ix.prm.steps[ix.step];
+    ix.state = State::kMove;
+    ix.move_start = ix.cmd_angle;
+    ix.lag_ticks = 0;
+    if (s.kind == Kind::kFixed) {
+        ix.target = ix.cmd_angle + s.angle;
+        ix.target_known = true;
+    } else {
+        // provisional: the fallback end of the turn
+        ix.target = ix.cmd_angle + sense(s.angle) * ix.prm.max_flex;
+        ix.target_known = false;
+    }
+}
+
+void enter_fault(Indexer& ix, Fault f) {
+    ix.state = State::kFault;
+    ix.fault = f;
+    ix.cmd_rate = 0.0;
+}
+
+/// The flexible stop condition of seed 002 on this tick's heading.
+bool flex_condition(const Indexer& ix, Kind kind, double yaw_p) {
+    double s;
+    double c;
+    pmath::sincos(yaw_p, &s, &c);
+    const double n_p = static_cast<double>(ix.prm.steps[ix.step].stop_ticks);
+    if (kind == Kind::kFlexCos) {
+        return std::fabs(c + ix.a_c / n_p) < ix.prm.delta && s * ix.a_s <= 0.0;
+    }
+    return std::fabs(s + ix.a_s / n_p) < ix.prm.delta && c * ix.a_c <= 0.0;
+}
+
+/// Advance the commanded angle one tick along a trapezoidal profile to
+/// target; returns true once the command has arrived.
+bool advance_command(Indexer& ix) {
+    const double remaining = ix.target - ix.cmd_angle;
+    const double dir = sense(remaining);
+    const double dist = std::fabs(remaining);
+    const double dt = ix.prm.dt;
+    double v = std::fabs(ix.cmd_rate) + ix.prm.accel * dt;
+    if (v > ix.prm.rate) {
+        v = ix.prm.rate;
+    }
+    const double v_brake = pmath::sqrt(2.0 * ix.prm.accel * dist);
+    if (v > v_brake) {
+        v = v_brake;
+    }
+    if (v * dt >= dist) {
+        ix.cmd_angle = ix.target;
+        ix.cmd_rate = 0.0;
+        return true;
+    }
+    ix.cmd_angle = ix.cmd_angle + dir * v * dt;
+    ix.cmd_rate = dir * v;
+    return false;
+}
+
+}  // namespace
+
+int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps) {
+    constexpr double kPi = 3.14159265358979323846;
+    const Kind fx = Kind::kFixed;
+    switch (scheme) {
+        case 0:  // none: the IMU stays fixed to the ship
+            return 0;
+        case 1:  // seed 003: stop at zero, +360 (counter-clockwise), stop, -360
+            steps[0] = Step{stop_ticks, fx, 2.0 * kPi};
+            steps[1] = Step{stop_ticks, fx, -2.0 * kPi};
+            return 2;
+        case 2:  // seed 002 traditional: stops at 0, 180, 0 (360), 180, back to 0
+            steps[0] = Step{stop_ticks, fx, kPi};
+            steps[1] = Step{stop_ticks, fx, kPi};
+            steps[2] = Step{stop_ticks, fx, -kPi};
+            steps[3] = Step{stop_ticks, fx, -kPi};
+            return 4;
+        case 3:  // four-position 0, 180, 90, 270 within 0..270 deg (no slip ring)
+            steps[0] = Step{stop_ticks, fx, kPi};
+            steps[1] = Step{stop_ticks, fx, -0.5 * kPi};
+            steps[2] = Step{stop_ticks, fx, kPi};
+            steps[3] = Step{stop_ticks, fx, -1.5 * kPi};
+            return 4;
+        case 4:  // seed 002 flexible: flex-cos forward, +180, flex-sin reverse, -180
+            steps[0] = Step{stop_ticks, Kind::kFlexCos, 1.0};
+            steps[1] = Step{stop_ticks, fx, kPi};
+            steps[2] = Step{stop_ticks, Kind::kFlexSin, -1.0};
+            steps[3] = Step{stop_ticks, fx, -kPi};
+            return 4;
+        default:
+            return -1;
+    }
+}
+
+void init(Indexer& ix, const Params& prm, double meas) {
+    ix.prm = prm;
+    ix.fault = Fault::kNone;
+    ix.step = 0;
+    ix.fallbacks = 0;
+    ix.a_c = 0.0;
+    ix.a_s = 0.0;
+    ix.cmd_angle = meas;
+    ix.target = meas;
+    ix.move_start = meas;
+    ix.prev_meas = meas;
+    ix.target_known = true;
+    if (prm.n_steps == 0) {
+        ix.state = State::kIdle;
+        ix.stop_count = 0;
+        ix.cmd_rate = 0.0;
+        ix.lag_ticks = 0;
+    } else {
+        start_stop(ix);
+    }
+}
+
+void reset(Indexer& ix, double meas) {
+    const double a_c = ix.a_c;
+    const double a_s = ix.a_s;
+    const int32_t fallbacks = ix.fallbacks;
+    init(ix, ix.prm, meas);
+    ix.a_c = a_c;
+    ix.a_s = a_s;
+    ix.fallbacks = fallbacks;
+}
+
+void update(Indexer& ix, double meas, double yaw_p) {
+    const double jumped = std::fabs(meas - ix.prev_meas);
+    ix.prev_meas = meas;
+    if (ix.state == State::kIdle || ix.state == State::kFault) {
+        return;
+    }
+    if (jumped > ix.prm.jump) {
+        enter_fault(ix, Fault::kJump);
+        return;
+    }
+    if (ix.state == State::kStop) {
+        double s;
+        double c;
+        pmath::sincos(yaw_p, &s, &c);
+        ix.a_c = ix.a_c + c;
+        ix.a_s = ix.a_s + s;
+        ix.stop_count = ix.stop_count + 1;
+        if (std::fabs(meas - ix.cmd_angle) > ix.prm.tolerance) {
+            ix.lag_ticks = ix.lag_ticks + 1;
+            if (ix.lag_ticks > ix.prm.timeout_ticks) {
+                enter_fault(ix, Fault::kDrift);
+                return;
+            }
+        } else {
+            ix.lag_ticks = 0;
+        }
+        if (ix.stop_count == ix.prm.steps[ix.step].stop_ticks) {
+            start_move(ix);
+        }
+        return;
+    }
+    // kMove
+    const Step& s = ix.prm.steps[ix.step];
+    if (!ix.target_known) {
+        if (flex_condition(ix, s.kind, yaw_p)) {
+            // stop as soon as the profile allows: brake from here
+            const double v = std::fabs(ix.cmd_rate);
+            ix.target = ix.cmd_angle + sense(s.angle) * (v * v / (2.0 * ix.prm.accel));
+            ix.target_known = true;
+        } else if (std::fabs(ix.cmd_angle - ix.move_start) >= ix.prm.max_flex) {
+            ix.target_known = true;   // no heading met the condition: give up here
+            ix.fallbacks = ix.fallbacks + 1;
+        }
+    }
+    const bool arrived = advance_command(ix);
+    if (std::fabs(meas - ix.cmd_angle) > ix.prm.tolerance) {
+        ix.lag_ticks = ix.lag_ticks + 1;
+        if (ix.lag_ticks > ix.prm.timeout_ticks) {
+            enter_fault(ix, Fault::kLag);
+            return;
+        }
+    } else {
+        ix.lag_ticks = 0;
+    }
+    if (arrived && ix.target_known) {
+        ix.step = (ix.step + 1) % ix.prm.n_steps;
+        start_stop(ix);
+    }
+}
+
+}  // namespace pyins::indexing

@@ -1,0 +1,93 @@
+// indexing.hpp: the indexing-motor state machine of a single-axis rotation-
+// modulated INS. Every scheme is data: a cycle of steps, each "stop for
+// stop_ticks, then move". Mirrored by pyins/reference/indexing.py.
+//
+// Move kinds:
+//   kFixed:   turn by `angle` (signed, rad; positive = "forward" =
+//             counter-clockwise seen from above, the sense of alpha).
+//   kFlexCos: seed 002 step 1: turn in the sense of `angle` until, on the
+//             first tick, |cos psi + A_c/N_p| < delta and sin psi * A_s <= 0.
+//   kFlexSin: seed 002 step 3: ... |sin psi + A_s/N_p| < delta and
+//             cos psi * A_c <= 0.
+// psi is the IMU yaw psi_p = psi_b + alpha from the firmware's own solution
+// (counter-clockwise, DESIGN.md); A_c, A_s accumulate cos psi, sin psi on
+// every tick the table is stopped, are frozen while it turns and are never
+// reset; N_p is the stop's length in ticks (SPEC 1.6 reading (b)).
+//
+// Choices the paper leaves open (docs/indexing.md):
+// - "opposite sign" takes zero as either sign (sin psi * A_s <= 0);
+// - no heading satisfying the condition within `max_flex` of turning (e.g.
+//   |A_c/N_p| > 1 + delta): the table stops after max_flex (default one
+//   turn) and the fallback is counted;
+// - the commanded motion is a trapezoidal rate profile (rate, accel); a
+//   flexible stop decelerates from the tick the condition holds, so the table
+//   stops v^2/(2 accel) further on (0.6 deg at 6 deg/s and 30 deg/s^2);
+// - faults: the encoder lagging the command by more than `tolerance` for
+//   `timeout_ticks` (stall, jam, wrong direction), or jumping by more than
+//   `jump` in one tick, or drifting off a stop: FAULT, command 0, until reset.
+#pragma once
+
+#include <cstdint>
+
+namespace pyins::indexing {
+
+enum class Kind : int32_t { kFixed = 1, kFlexCos = 2, kFlexSin = 3 };
+enum class State : int32_t { kIdle = 0, kStop = 1, kMove = 2, kFault = 3 };
+enum class Fault : int32_t { kNone = 0, kLag = 1, kJump = 2, kDrift = 3 };
+
+inline constexpr int kMaxSteps = 8;
+
+struct Step {
+    int32_t stop_ticks;
+    Kind kind;
+    double angle;          ///< fixed: signed turn [rad]; flexible: its sign is the sense
+};
+
+struct Params {
+    Step steps[kMaxSteps];
+    int32_t n_steps;       ///< 0: no rotation (the table stays put)
+    double rate;           ///< cruise rate [rad/s] > 0
+    double accel;          ///< acceleration [rad/s^2] > 0
+    double delta;          ///< flexible threshold (0.01 at 100 Hz, seed 002)
+    double max_flex;       ///< longest flexible turn [rad]
+    double tolerance;      ///< position tolerance [rad]
+    double jump;           ///< largest believable encoder change in one tick [rad]
+    int32_t timeout_ticks; ///< how long the encoder may lag
+    double dt;             ///< tick [s]
+};
+
+struct Indexer {
+    Params prm;
+    State state;
+    Fault fault;
+    int32_t step;          ///< current step of the cycle
+    int32_t stop_count;    ///< ticks stopped in this step
+    int32_t lag_ticks;     ///< consecutive ticks the encoder is off the command
+    int32_t fallbacks;     ///< flexible turns that ended at max_flex
+    double a_c;            ///< sum of cos psi over stopped ticks
+    double a_s;            ///< sum of sin psi over stopped ticks
+    double cmd_angle;      ///< commanded (unwrapped) table angle [rad]
+    double cmd_rate;       ///< commanded rate [rad/s] (signed)
+    double target;         ///< where the current move ends [rad]
+    double move_start;     ///< commanded angle at the start of the move [rad]
+    double prev_meas;      ///< last encoder reading (unwrapped) [rad]
+    bool target_known;     ///< fixed move, or flexible condition met / fallback
+};
+
+/// Preset schemes (enum pyins_index_scheme): 0 none, 1 single-position
+/// forward/reverse (seed 003), 2 traditional two-position (seed 002),
+/// 3 four-position, 4 flexible two-position (seed 002). Writes the cycle into
+/// steps (room for kMaxSteps) and returns its length, or -1 if unknown.
+int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps);
+
+/// Start at the measured (unwrapped) table angle, first step, stopped.
+void init(Indexer& ix, const Params& prm, double meas);
+
+/// One tick, after the navigation update: meas = unwrapped encoder angle at
+/// t_k [rad], yaw_p = IMU yaw from the solution [rad].
+void update(Indexer& ix, double meas, double yaw_p);
+
+/// Leave FAULT: start the cycle again at the measured angle, keeping A_c, A_s.
+void reset(Indexer& ix, double meas);
+
+}  // namespace pyins::indexing

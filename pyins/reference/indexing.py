@@ -1,0 +1,212 @@
+"""The indexing-motor state machine. Mirrors ``csrc/src/indexing.{hpp,cpp}``
+(the header documents the schemes-as-data design and every choice)."""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+KIND_FIXED = 1       #: Kind::kFixed
+KIND_FLEX_COS = 2    #: Kind::kFlexCos
+KIND_FLEX_SIN = 3    #: Kind::kFlexSin
+
+STATE_IDLE = 0       #: State::kIdle
+STATE_STOP = 1       #: State::kStop
+STATE_MOVE = 2       #: State::kMove
+STATE_FAULT = 3      #: State::kFault
+
+FAULT_NONE = 0
+FAULT_LAG = 1
+FAULT_JUMP = 2
+FAULT_DRIFT = 3
+
+MAX_STEPS = 8        #: kMaxSteps
+
+
+@dataclass
+class Step:
+    stop_ticks: int
+    kind: int
+    angle: float
+
+
+@dataclass
+class Params:
+    steps: list
+    rate: float
+    accel: float
+    delta: float
+    max_flex: float
+    tolerance: float
+    jump: float
+    timeout_ticks: int
+    dt: float
+
+    @property
+    def n_steps(self):
+        return len(self.steps)
+
+
+@dataclass
+class Indexer:
+    prm: Params
+    state: int = STATE_IDLE
+    fault: int = FAULT_NONE
+    step: int = 0
+    stop_count: int = 0
+    lag_ticks: int = 0
+    fallbacks: int = 0
+    a_c: float = 0.0
+    a_s: float = 0.0
+    cmd_angle: float = 0.0
+    cmd_rate: float = 0.0
+    target: float = 0.0
+    move_start: float = 0.0
+    prev_meas: float = 0.0
+    target_known: bool = True
+
+
+def preset_steps(scheme, stop_ticks):
+    """Steps of a preset scheme (mirrors ``indexing::preset_steps``); None if unknown."""
+    fx = KIND_FIXED
+    pi = np.pi
+    table = {
+        0: [],
+        1: [(fx, 2.0 * pi), (fx, -2.0 * pi)],
+        2: [(fx, pi), (fx, pi), (fx, -pi), (fx, -pi)],
+        3: [(fx, pi), (fx, -0.5 * pi), (fx, pi), (fx, -1.5 * pi)],
+        4: [(KIND_FLEX_COS, 1.0), (fx, pi), (KIND_FLEX_SIN, -1.0), (fx, -pi)],
+    }
+    if scheme not in table:
+        return None
+    return [Step(stop_ticks, kind, angle) for kind, angle in table[scheme]]
+
+
+def run(prm, meas0, meas, yaw_b):
+    """Mirror of the test hook pyins_t_indexing_run: per-tick records."""
+    ix = init(prm, meas0)
+    out = []
+    for k in range(len(yaw_b)):
+        m = meas[k] if meas is not None else ix.cmd_angle
+        update(ix, m, yaw_b[k] + m)
+        out.append((ix.state, ix.step, ix.fault, ix.fallbacks, ix.cmd_angle, ix.cmd_rate,
+                    ix.a_c, ix.a_s))
+    return out
+
+
+def _sense(angle):
+    return -1.0 if angle < 0.0 else 1.0
+
+
+def _start_stop(ix):
+    ix.state = STATE_STOP
+    ix.stop_count = 0
+    ix.cmd_rate = 0.0
+    ix.lag_ticks = 0
+
+
+def _start_move(ix):
+    s = ix.prm.steps[ix.step]
+    ix.state = STATE_MOVE
+    ix.move_start = ix.cmd_angle
+    ix.lag_ticks = 0
+    if s.kind == KIND_FIXED:
+        ix.target = ix.cmd_angle + s.angle
+        ix.target_known = True
+    else:
+        ix.target = ix.cmd_angle + _sense(s.angle) * ix.prm.max_flex
+        ix.target_known = False
+
+
+def _enter_fault(ix, f):
+    ix.state = STATE_FAULT
+    ix.fault = f
+    ix.cmd_rate = 0.0
+
+
+def _flex_condition(ix, kind, yaw_p):
+    s = np.sin(yaw_p)
+    c = np.cos(yaw_p)
+    n_p = float(ix.prm.steps[ix.step].stop_ticks)
+    if kind == KIND_FLEX_COS:
+        return abs(c + ix.a_c / n_p) < ix.prm.delta and s * ix.a_s <= 0.0
+    return abs(s + ix.a_s / n_p) < ix.prm.delta and c * ix.a_c <= 0.0
+
+
+def _advance_command(ix):
+    remaining = ix.target - ix.cmd_angle
+    direction = _sense(remaining)
+    dist = abs(remaining)
+    dt = ix.prm.dt
+    v = abs(ix.cmd_rate) + ix.prm.accel * dt
+    if v > ix.prm.rate:
+        v = ix.prm.rate
+    v_brake = np.sqrt(2.0 * ix.prm.accel * dist)
+    if v > v_brake:
+        v = v_brake
+    if v * dt >= dist:
+        ix.cmd_angle = ix.target
+        ix.cmd_rate = 0.0
+        return True
+    ix.cmd_angle = ix.cmd_angle + direction * v * dt
+    ix.cmd_rate = direction * v
+    return False
+
+
+def init(prm, meas):
+    ix = Indexer(prm=prm, cmd_angle=meas, target=meas, move_start=meas, prev_meas=meas)
+    if prm.n_steps == 0:
+        ix.state = STATE_IDLE
+    else:
+        _start_stop(ix)
+    return ix
+
+
+def reset(ix, meas):
+    """Leave FAULT: start the cycle again at ``meas``, keeping A_c, A_s."""
+    new = init(ix.prm, meas)
+    new.a_c, new.a_s, new.fallbacks = ix.a_c, ix.a_s, ix.fallbacks
+    return new
+
+
+def update(ix, meas, yaw_p):
+    """One tick (mirrors ``indexing::update``)."""
+    jumped = abs(meas - ix.prev_meas)
+    ix.prev_meas = meas
+    if ix.state in (STATE_IDLE, STATE_FAULT):
+        return
+    if jumped > ix.prm.jump:
+        _enter_fault(ix, FAULT_JUMP)
+        return
+    if ix.state == STATE_STOP:
+        ix.a_c = ix.a_c + np.cos(yaw_p)
+        ix.a_s = ix.a_s + np.sin(yaw_p)
+        ix.stop_count = ix.stop_count + 1
+        if abs(meas - ix.cmd_angle) > ix.prm.tolerance:
+            ix.lag_ticks = ix.lag_ticks + 1
+            if ix.lag_ticks > ix.prm.timeout_ticks:
+                _enter_fault(ix, FAULT_DRIFT)
+                return
+        else:
+            ix.lag_ticks = 0
+        if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
+            _start_move(ix)
+        return
+    s = ix.prm.steps[ix.step]
+    if not ix.target_known:
+        if _flex_condition(ix, s.kind, yaw_p):
+            v = abs(ix.cmd_rate)
+            ix.target = ix.cmd_angle + _sense(s.angle) * (v * v / (2.0 * ix.prm.accel))
+            ix.target_known = True
+        elif abs(ix.cmd_angle - ix.move_start) >= ix.prm.max_flex:
+            ix.target_known = True
+            ix.fallbacks = ix.fallbacks + 1
+    arrived = _advance_command(ix)
+    if abs(meas - ix.cmd_angle) > ix.prm.tolerance:
+        ix.lag_ticks = ix.lag_ticks + 1
+        if ix.lag_ticks > ix.prm.timeout_ticks:
+            _enter_fault(ix, FAULT_LAG)
+            return
+    else:
+        ix.lag_ticks = 0
+    if arrived and ix.target_known:
+        ix.step = (ix.step + 1) % ix.prm.n_steps
+        _start_stop(ix)
