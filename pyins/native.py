@@ -19,7 +19,7 @@ import numpy as np
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 4)
+EXPECTED_ABI = (0, 5)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h")
@@ -220,6 +220,19 @@ def make_config(config=None, **fields):
                 raise ValueError(f"config: vertical_mode {value!r} is not one of {sorted(VERTICAL_MODES)}")
             value = VERTICAL_MODES[value]
         current = getattr(cfg, key)
+        if key == "index_steps":
+            steps = list(value)
+            if len(steps) > len(current):
+                raise ValueError(f"config: index_steps holds at most {len(current)} steps, got {len(steps)}")
+            for i, step in enumerate(steps):
+                try:
+                    stop, kind, angle = (step["stop_ticks"], step["kind"], step["angle_rad"]) \
+                        if isinstance(step, dict) else step
+                    current[i].stop_ticks, current[i].kind, current[i].angle_rad = stop, kind, angle
+                except (TypeError, ValueError, KeyError, OverflowError) as exc:
+                    raise ValueError(f"config: index_steps[{i}] must be (stop_ticks, kind, angle_rad): "
+                                     f"{exc}") from None
+            continue
         if isinstance(current, ffi.CData):   # a fixed-length array field
             arr = np.asarray(value, dtype=np.float64)
             if arr.shape != (len(current),):
@@ -251,8 +264,8 @@ class Firmware:
         status = lib.pyins_init(self._core, size, cfg)
         if status != 0:
             raise ConfigError(status, "pyins_init")
-        self.config = {name: (list(getattr(cfg, name)) if isinstance(getattr(cfg, name), ffi.CData)
-                              else getattr(cfg, name)) for name in CONFIG_FIELDS}
+        self.config = {name: getattr(cfg, name) for name in CONFIG_FIELDS
+                       if not isinstance(getattr(cfg, name), ffi.CData)}
         self._one_out = np.zeros(1, dtype=OUTPUT_DTYPE)
         self._one_out_ptr = ffi.cast("pyins_output *", ffi.from_buffer(self._one_out))
         self._one_sample = np.zeros(1, dtype=SAMPLE_DTYPE)
@@ -276,6 +289,12 @@ class Firmware:
                 raise SampleError(status, int(n_done[0]), outputs[: n_out[0]].copy())
             raise CoreError(status, "pyins_run_decimated")
         return outputs[: n_out[0]]
+
+    def index_reset(self):
+        """Leave the indexing FAULT state (pyins_index_reset)."""
+        status = lib.pyins_index_reset(self._core)
+        if status != 0:
+            raise CoreError(status, "pyins_index_reset")
 
     @property
     def core(self):

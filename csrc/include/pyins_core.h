@@ -26,7 +26,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 4
+#define PYINS_ABI_VERSION_MINOR 5
 
 #ifdef __cplusplus
 extern "C" {
@@ -60,8 +60,42 @@ enum pyins_status {
     PYINS_E_CONFIG_ALIGN_LONG = -19,  /* coarse alignment longer than its fixed storage allows */
     PYINS_E_CONFIG_ALIGN_TICKS = -20, /* an alignment duration negative, or first output after its end */
     PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5 or 8, negative update interval, unknown correction */
-    PYINS_E_CONFIG_NOISE = -22        /* a noise density or initial sigma negative or not finite */
+    PYINS_E_CONFIG_NOISE = -22,       /* a noise density or initial sigma negative or not finite */
+    PYINS_E_CONFIG_INDEX_SCHEME = -23, /* unknown indexing scheme */
+    PYINS_E_CONFIG_INDEX_EMPTY = -24, /* custom scheme with no steps (or more than 8) */
+    PYINS_E_CONFIG_INDEX_RATE = -25,  /* indexing rate or acceleration not positive (custom) or negative */
+    PYINS_E_CONFIG_INDEX_DELTA = -26, /* flexible threshold delta not positive (custom) or negative */
+    PYINS_E_CONFIG_INDEX_STEP = -27   /* a custom step, stop length, tolerance or timeout out of range */
 };
+
+/* Indexing schemes (pyins_config.index_scheme). */
+enum pyins_index_scheme {
+    PYINS_INDEX_NONE = 0,             /* the IMU stays fixed to the ship */
+    PYINS_INDEX_SINGLE_FWD_REV = 1,   /* seed 003: stop, +360, stop, -360 (stops at zero) */
+    PYINS_INDEX_TWO_POSITION = 2,     /* seed 002 traditional: stop, +180, stop, +180, stop, -180, stop, -180 */
+    PYINS_INDEX_FOUR_POSITION = 3,    /* stops at 0, 180, 90, 270: +180, -90, +180, -270 (no slip ring) */
+    PYINS_INDEX_FLEXIBLE_TWO = 4,     /* seed 002 flexible: flex-cos fwd, +180, flex-sin rev, -180 */
+    PYINS_INDEX_CUSTOM = 5            /* index_steps[0 .. index_n_steps-1] */
+};
+
+/* Move kinds of an indexing step. */
+enum pyins_index_kind {
+    PYINS_INDEX_FIXED = 1,            /* turn by angle_rad (signed; + = counter-clockwise from above) */
+    PYINS_INDEX_FLEX_COS = 2,         /* turn in the sense of angle_rad until seed 002's cos condition */
+    PYINS_INDEX_FLEX_SIN = 3          /* ... until seed 002's sin condition */
+};
+
+/* Indexing machine states (pyins_output.index_state). */
+enum pyins_index_state {
+    PYINS_INDEX_IDLE = 0, PYINS_INDEX_STOP = 1, PYINS_INDEX_MOVE = 2, PYINS_INDEX_FAULT = 3
+};
+
+/* One step of an indexing cycle: stop for stop_ticks, then move. */
+typedef struct pyins_index_step {
+    int32_t stop_ticks;
+    int32_t kind;                 /* enum pyins_index_kind */
+    double angle_rad;
+} pyins_index_step;
 
 /* How the fine alignment uses its attitude estimate. */
 enum pyins_fine_correction {
@@ -122,6 +156,19 @@ typedef struct pyins_config {
     double fine_sigma0_att_rad[3]; /* initial sigma of phi E, N, U [rad]; 0 = 100', 100', 600' */
     double fine_sigma0_gyro;      /* initial sigma of the gyro drifts [rad/s]; 0 = 0.01 deg/h */
     double fine_sigma0_accel;     /* initial sigma of the accelerometer biases [m/s^2]; 0 = 100 ug */
+    /* Indexing (rotation modulation), active in NAVIGATE. For preset schemes
+     * 0 means the default; a custom scheme states rate, accel and delta. */
+    int32_t index_scheme;         /* enum pyins_index_scheme */
+    int32_t index_stop_ticks;     /* presets: stop length [ticks]; 0 = 60 s (seed 003), 300 s (others) */
+    int32_t index_timeout_ticks;  /* how long the encoder may lag the command [ticks]; 0 = 2 s */
+    int32_t index_n_steps;        /* custom scheme: steps used, 1..8 */
+    double index_rate_rad_s;      /* cruise rate; 0 = 6 deg/s */
+    double index_accel_rad_s2;    /* acceleration; 0 = 30 deg/s^2 */
+    double index_delta;           /* flexible threshold; 0 = 0.01 */
+    double index_max_flex_rad;    /* longest flexible turn before giving up; 0 = 720 deg */
+    double index_tolerance_rad;   /* encoder vs command tolerance; 0 = 0.5 deg */
+    double index_jump_rad;        /* largest believable encoder change per tick; 0 = 5 deg */
+    pyins_index_step index_steps[8]; /* custom scheme */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -152,6 +199,14 @@ typedef struct pyins_output {
     int32_t align_restarts;       /* alignments restarted after a rejected sample */
     double kf_x[8];               /* fine-alignment state, fine_align.hpp layout [rad, rad/s, m/s^2] */
     double kf_sigma[8];           /* its standard deviations, same units */
+    int32_t index_state;          /* enum pyins_index_state */
+    int32_t index_step;           /* step of the cycle */
+    int32_t index_fault;          /* 0 none, 1 encoder lags the command, 2 encoder jump, 3 drift off a stop */
+    int32_t index_fallbacks;      /* flexible turns that found no heading and stopped at the maximum */
+    double motor_rate_cmd_rad_s;  /* commanded table rate */
+    double table_angle_cmd_rad;   /* commanded (unwrapped) table angle */
+    double index_a_c;             /* seed 002's cos accumulator A_c */
+    double index_a_s;             /* seed 002's sin accumulator A_s */
 } pyins_output;
 
 /* The firmware instance. Opaque: it lives in caller memory of
@@ -212,6 +267,11 @@ int pyins_run(pyins_core *core, const pyins_sample *samples, size_t n,
 int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
                         size_t out_every, pyins_output *outputs, size_t out_capacity,
                         size_t *n_done, size_t *n_out);
+
+/* Leave the indexing FAULT state: the cycle starts again at its first step
+ * from the measured table angle (A_c, A_s kept). Does nothing otherwise.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_index_reset(pyins_core *core);
 
 /* Write the current state as an output record (no step).
  * Returns PYINS_OK or a negative pyins_status. */

@@ -172,6 +172,16 @@ int pyins_run_decimated(pyins_core* core, const pyins_sample* samples, size_t n,
     return PYINS_OK;
 }
 
+int pyins_index_reset(pyins_core* core) {
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    const_cast<Firmware*>(cfw)->index_reset();
+    return PYINS_OK;
+}
+
 int pyins_get_output(const pyins_core* core, pyins_output* out) {
     const Firmware* fw = nullptr;
     const int status = checked(core, &fw);
@@ -207,6 +217,11 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_ALIGN_LONG: return "PYINS_E_CONFIG_ALIGN_LONG: coarse alignment longer than its storage allows (255 output intervals)";
         case PYINS_E_CONFIG_FINE: return "PYINS_E_CONFIG_FINE: fine_states must be 5 or 8, the update interval positive, the correction known";
         case PYINS_E_CONFIG_NOISE: return "PYINS_E_CONFIG_NOISE: noise densities and initial sigmas must be positive and finite (0 = default)";
+        case PYINS_E_CONFIG_INDEX_SCHEME: return "PYINS_E_CONFIG_INDEX_SCHEME: index_scheme is not one of the pyins_index_scheme values";
+        case PYINS_E_CONFIG_INDEX_EMPTY: return "PYINS_E_CONFIG_INDEX_EMPTY: a custom indexing scheme needs 1..8 steps";
+        case PYINS_E_CONFIG_INDEX_RATE: return "PYINS_E_CONFIG_INDEX_RATE: indexing rate and acceleration must be positive and finite";
+        case PYINS_E_CONFIG_INDEX_DELTA: return "PYINS_E_CONFIG_INDEX_DELTA: the flexible threshold delta must be in (0, 1)";
+        case PYINS_E_CONFIG_INDEX_STEP: return "PYINS_E_CONFIG_INDEX_STEP: an indexing step (stop ticks >= 1, known kind, non-zero finite angle), tolerance, jump or timeout out of range";
         case PYINS_E_CONFIG_ALIGN_TICKS: return "PYINS_E_CONFIG_ALIGN_TICKS: an alignment duration is negative, or the first output comes after its end";
         default: return "unknown pyins status code";
     }

@@ -49,6 +49,53 @@ void config_default(pyins_config* cfg) {
     cfg->vertical_mode = PYINS_VERTICAL_HOLD;
 }
 
+namespace {
+
+/// The indexing part of config_check, on a resolved configuration.
+int index_check(const pyins_config& cfg) {
+    if (cfg.index_scheme < PYINS_INDEX_NONE || cfg.index_scheme > PYINS_INDEX_CUSTOM) {
+        return PYINS_E_CONFIG_INDEX_SCHEME;
+    }
+    if (cfg.index_scheme == PYINS_INDEX_NONE) {
+        return PYINS_OK;
+    }
+    bool flexible = cfg.index_scheme == PYINS_INDEX_FLEXIBLE_TWO;
+    if (cfg.index_scheme == PYINS_INDEX_CUSTOM) {
+        if (cfg.index_n_steps < 1 || cfg.index_n_steps > indexing::kMaxSteps) {
+            return PYINS_E_CONFIG_INDEX_EMPTY;
+        }
+        for (int32_t i = 0; i < cfg.index_n_steps; ++i) {
+            const pyins_index_step& s = cfg.index_steps[i];
+            if (s.stop_ticks < 1 || !std::isfinite(s.angle_rad) ||
+                (s.kind != PYINS_INDEX_FIXED && s.kind != PYINS_INDEX_FLEX_COS &&
+                 s.kind != PYINS_INDEX_FLEX_SIN) ||
+                (s.kind == PYINS_INDEX_FIXED && s.angle_rad == 0.0) ||
+                std::fabs(s.angle_rad) > 16.0 * earth::kPi) {
+                return PYINS_E_CONFIG_INDEX_STEP;
+            }
+            flexible = flexible || s.kind != PYINS_INDEX_FIXED;
+        }
+    } else if (cfg.index_stop_ticks < 1) {
+        return PYINS_E_CONFIG_INDEX_STEP;
+    }
+    if (!(cfg.index_rate_rad_s > 0.0) || !(cfg.index_accel_rad_s2 > 0.0) ||
+        !std::isfinite(cfg.index_rate_rad_s) || !std::isfinite(cfg.index_accel_rad_s2)) {
+        return PYINS_E_CONFIG_INDEX_RATE;
+    }
+    if (flexible && (!(cfg.index_delta > 0.0) || !(cfg.index_delta < 1.0))) {
+        return PYINS_E_CONFIG_INDEX_DELTA;
+    }
+    if (!(cfg.index_max_flex_rad > 0.0) || !(cfg.index_tolerance_rad > 0.0) ||
+        !(cfg.index_jump_rad > 0.0) || !std::isfinite(cfg.index_max_flex_rad) ||
+        !std::isfinite(cfg.index_tolerance_rad) || !std::isfinite(cfg.index_jump_rad) ||
+        cfg.index_timeout_ticks < 1) {
+        return PYINS_E_CONFIG_INDEX_STEP;
+    }
+    return PYINS_OK;
+}
+
+}  // namespace
+
 pyins_config config_resolved(const pyins_config& in) {
     pyins_config cfg = in;
     if (cfg.tick_hz == 0) {
@@ -85,6 +132,34 @@ pyins_config config_resolved(const pyins_config& in) {
     }
     if (cfg.fine_sigma0_accel == 0.0) {
         cfg.fine_sigma0_accel = kDefaultFineSigmaAccel;
+    }
+    if (cfg.index_scheme != PYINS_INDEX_CUSTOM) {
+        if (cfg.index_stop_ticks == 0) {
+            const int32_t s = cfg.index_scheme == PYINS_INDEX_SINGLE_FWD_REV ? kDefaultStopSeed003S
+                                                                            : kDefaultStopS;
+            cfg.index_stop_ticks = s * cfg.tick_hz;
+        }
+        if (cfg.index_rate_rad_s == 0.0) {
+            cfg.index_rate_rad_s = kDefaultIndexRate;
+        }
+        if (cfg.index_accel_rad_s2 == 0.0) {
+            cfg.index_accel_rad_s2 = kDefaultIndexAccel;
+        }
+        if (cfg.index_delta == 0.0) {
+            cfg.index_delta = kDefaultIndexDelta;
+        }
+    }
+    if (cfg.index_max_flex_rad == 0.0) {
+        cfg.index_max_flex_rad = kDefaultIndexMaxFlex;
+    }
+    if (cfg.index_tolerance_rad == 0.0) {
+        cfg.index_tolerance_rad = kDefaultIndexTolerance;
+    }
+    if (cfg.index_jump_rad == 0.0) {
+        cfg.index_jump_rad = kDefaultIndexJump;
+    }
+    if (cfg.index_timeout_ticks == 0) {
+        cfg.index_timeout_ticks = kDefaultIndexTimeoutS * cfg.tick_hz;
     }
     return cfg;
 }
@@ -148,7 +223,7 @@ int config_check(const pyins_config& raw) {
             return PYINS_E_CONFIG_NOISE;
         }
     }
-    return PYINS_OK;
+    return index_check(cfg);
 }
 
 void Firmware::init(const pyins_config& raw) {
@@ -192,7 +267,50 @@ void Firmware::init(const pyins_config& raw) {
         prm.gravity = earth::normal_gravity(prm.sin_lat, cfg.height_m);
         coarse_align::init(coarse_, prm);
     }
+    indexing::Params& ip = index_prm_;
+    if (cfg.index_scheme == PYINS_INDEX_CUSTOM) {
+        ip.n_steps = cfg.index_n_steps;
+        for (int32_t i = 0; i < cfg.index_n_steps; ++i) {
+            ip.steps[i].stop_ticks = cfg.index_steps[i].stop_ticks;
+            ip.steps[i].kind = static_cast<indexing::Kind>(cfg.index_steps[i].kind);
+            ip.steps[i].angle = cfg.index_steps[i].angle_rad;
+        }
+    } else {
+        ip.n_steps = indexing::preset_steps(cfg.index_scheme, cfg.index_stop_ticks, ip.steps);
+    }
+    ip.rate = cfg.index_rate_rad_s;
+    ip.accel = cfg.index_accel_rad_s2;
+    ip.delta = cfg.index_delta;
+    ip.max_flex = cfg.index_max_flex_rad;
+    ip.tolerance = cfg.index_tolerance_rad;
+    ip.jump = cfg.index_jump_rad;
+    ip.timeout_ticks = cfg.index_timeout_ticks;
+    ip.dt = dt_;
+    // Before NAVIGATE the table is held where it is (an idle machine, command 0).
+    indexing::Params idle = ip;
+    idle.n_steps = 0;
+    indexing::init(idx_, idle, table_angle_);
     magic_ = kMagic;
+}
+
+void Firmware::start_navigation() {
+    mode_ = Mode::kNavigate;
+    indexing::init(idx_, index_prm_, table_angle_);
+}
+
+double Firmware::imu_yaw() const {
+    const Quat q_pb{enc_cos_half_, 0.0, 0.0, -enc_sin_half_};
+    const Quat q_nb = attitude::quat_mul(sd_.nav.quat_np, q_pb);
+    // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler), from q directly
+    const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
+    const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
+    return wrap_pi(pmath::atan2(-c01, c11) + encoder_);
+}
+
+void Firmware::index_reset() {
+    if (idx_.state == indexing::State::kFault) {
+        indexing::reset(idx_, table_angle_);
+    }
 }
 
 void Firmware::end_coarse() {
@@ -208,7 +326,7 @@ void Firmware::end_coarse() {
     if (cfg_.fine_ticks > 0) {
         start_fine();
     } else {
-        mode_ = Mode::kNavigate;
+        start_navigation();
     }
 }
 
@@ -259,7 +377,7 @@ void Firmware::apply_fine_correction() {
 void Firmware::end_fine() {
     // Navigation starts from the corrected attitude (both correction modes).
     apply_fine_correction();
-    mode_ = Mode::kNavigate;
+    start_navigation();
 }
 
 void Firmware::hold_at_site() {
@@ -287,6 +405,13 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     }
     const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
     const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
+    // Unwrap the encoder: the table turns far less than pi per tick.
+    const double encoder = wrap_two_pi(sample.table_angle_rad);
+    table_angle_ = table_angle_ + wrap_pi(encoder - encoder_);
+    if (encoder != encoder_) {  // the table moved: refresh the cached half-angle
+        encoder_ = encoder;
+        pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
+    }
     if (gap_pending_) {
         gap_pending_ = false;
         align_restarts_ = align_restarts_ + 1;
@@ -304,7 +429,7 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
         } else if (cfg_.fine_ticks > 0) {
             start_fine();
         } else {
-            mode_ = Mode::kNavigate;
+            start_navigation();
         }
     }
     if (mode_ == Mode::kCoarseAlign) {
@@ -337,15 +462,11 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
         }
     } else {
         strapdown::update(sd_, dtheta_p, dv_p, dt_);
+        if (index_prm_.n_steps > 0) {
+            indexing::update(idx_, table_angle_, imu_yaw());
+        }
     }
 
-    // Unwrap the encoder: the table turns far less than pi per tick.
-    const double encoder = wrap_two_pi(sample.table_angle_rad);
-    table_angle_ = table_angle_ + wrap_pi(encoder - encoder_);
-    if (encoder != encoder_) {  // the table moved: refresh the cached half-angle
-        encoder_ = encoder;
-        pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
-    }
     tick_ = tick_ + 1;
     if (out != nullptr) {
         output(out);
@@ -396,6 +517,14 @@ void Firmware::output(pyins_output* out) const {
     out->heading_b_rad = attitude::yaw_to_heading(euler_b(2));
     out->yaw_p_rad = wrap_pi(euler_b(2) + encoder_);
     out->table_angle_rad = table_angle_;
+    out->index_state = static_cast<int32_t>(idx_.state);
+    out->index_step = idx_.step;
+    out->index_fault = static_cast<int32_t>(idx_.fault);
+    out->index_fallbacks = idx_.fallbacks;
+    out->motor_rate_cmd_rad_s = idx_.cmd_rate;
+    out->table_angle_cmd_rad = idx_.cmd_angle;
+    out->index_a_c = idx_.a_c;
+    out->index_a_s = idx_.a_s;
     out->kf_states = kf_states_;
     out->align_restarts = align_restarts_;
     for (int i = 0; i < 8; ++i) {

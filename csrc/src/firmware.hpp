@@ -10,6 +10,7 @@
 #include "pyins_core.h"
 #include "coarse_align.hpp"
 #include "fine_align.hpp"
+#include "indexing.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 
@@ -36,6 +37,17 @@ inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminRad, 100.0 * k
                                                    600.0 * kArcminRad};  ///< 10 x [10', 10', 60']
 inline constexpr double kDefaultFineSigmaGyro = 0.01 * (3.14159265358979323846 / 180.0) / 3600.0;
 inline constexpr double kDefaultFineSigmaAccel = 100.0e-6 * 9.80665;  ///< 100 ug (not in seed 001)
+/// Indexing defaults (seeds 002, 003: 6 deg/s; stops 60 s in seed 003, 300 s in seed 002).
+inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
+inline constexpr double kDefaultIndexRate = 6.0 * kDeg;
+inline constexpr double kDefaultIndexAccel = 30.0 * kDeg;     ///< not in the papers
+inline constexpr double kDefaultIndexDelta = 0.01;            ///< seed 002, at 100 Hz
+inline constexpr double kDefaultIndexMaxFlex = 720.0 * kDeg;  ///< two turns: the ship may turn back
+inline constexpr double kDefaultIndexTolerance = 0.5 * kDeg;
+inline constexpr double kDefaultIndexJump = 5.0 * kDeg;
+inline constexpr int32_t kDefaultIndexTimeoutS = 2;
+inline constexpr int32_t kDefaultStopSeed003S = 60;
+inline constexpr int32_t kDefaultStopS = 300;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -60,6 +72,9 @@ class Firmware {
     /// The current state as an output record.
     void output(pyins_output* out) const;
 
+    /// Leave the indexing FAULT state (pyins_index_reset).
+    void index_reset();
+
     uint32_t magic() const { return magic_; }
     int64_t tick() const { return tick_; }
 
@@ -75,6 +90,10 @@ class Firmware {
     Vec3 fine_phi() const;
     /// Hold the static-base assumption of the alignment: site, at rest.
     void hold_at_site();
+    /// Enter NAVIGATE: the indexing cycle starts from the measured angle.
+    void start_navigation();
+    /// IMU yaw psi_p = psi_b + alpha (DESIGN.md) from the current solution.
+    double imu_yaw() const;
 
     uint32_t magic_;
     Mode mode_;
@@ -90,6 +109,8 @@ class Firmware {
     int32_t align_restarts_;      ///< alignments restarted after a rejected sample
     bool gap_pending_;            ///< a sample was rejected during alignment
     uint32_t faults_;             ///< sticky pyins_fault_flag bits
+    indexing::Params index_prm_;  ///< the configured cycle (started in NAVIGATE)
+    indexing::Indexer idx_;
     bool att_valid_;              ///< attitude is a solution (not the configured guess)
     double table_angle_;          ///< unwrapped turntable angle alpha [rad]
     double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from . import attitude, coarse_align, earth, fine_align, strapdown
+from . import attitude, coarse_align, earth, fine_align, indexing, strapdown
 
 # Status codes: pinned values of enum pyins_status.
 PYINS_OK = 0
@@ -32,6 +32,14 @@ PYINS_E_CONFIG_ALIGN_LONG = -19
 PYINS_E_CONFIG_ALIGN_TICKS = -20
 PYINS_E_CONFIG_FINE = -21
 PYINS_E_CONFIG_NOISE = -22
+PYINS_E_CONFIG_INDEX_SCHEME = -23
+PYINS_E_CONFIG_INDEX_EMPTY = -24
+PYINS_E_CONFIG_INDEX_RATE = -25
+PYINS_E_CONFIG_INDEX_DELTA = -26
+PYINS_E_CONFIG_INDEX_STEP = -27
+
+INDEX_NONE, INDEX_SINGLE_FWD_REV, INDEX_TWO_POSITION, INDEX_FOUR_POSITION = 0, 1, 2, 3
+INDEX_FLEXIBLE_TWO, INDEX_CUSTOM = 4, 5
 
 FINE_FEEDBACK = 0      #: PYINS_FINE_FEEDBACK
 FINE_OPEN_LOOP = 1     #: PYINS_FINE_OPEN_LOOP
@@ -56,6 +64,16 @@ ARCMIN_RAD = np.pi / 180.0 / 60.0                           #: kArcminRad
 DEFAULT_FINE_SIGMA_ATT = (100.0 * ARCMIN_RAD, 100.0 * ARCMIN_RAD, 600.0 * ARCMIN_RAD)
 DEFAULT_FINE_SIGMA_GYRO = 0.01 * (np.pi / 180.0) / 3600.0   #: kDefaultFineSigmaGyro
 DEFAULT_FINE_SIGMA_ACCEL = 100.0e-6 * 9.80665               #: kDefaultFineSigmaAccel
+DEG = np.pi / 180.0                                         #: kDeg
+DEFAULT_INDEX_RATE = 6.0 * DEG          #: kDefaultIndexRate
+DEFAULT_INDEX_ACCEL = 30.0 * DEG        #: kDefaultIndexAccel
+DEFAULT_INDEX_DELTA = 0.01              #: kDefaultIndexDelta
+DEFAULT_INDEX_MAX_FLEX = 720.0 * DEG    #: kDefaultIndexMaxFlex
+DEFAULT_INDEX_TOLERANCE = 0.5 * DEG     #: kDefaultIndexTolerance
+DEFAULT_INDEX_JUMP = 5.0 * DEG          #: kDefaultIndexJump
+DEFAULT_INDEX_TIMEOUT_S = 2             #: kDefaultIndexTimeoutS
+DEFAULT_STOP_SEED003_S = 60             #: kDefaultStopSeed003S
+DEFAULT_STOP_S = 300                    #: kDefaultStopS
 
 DEFAULT_TICK_HZ = 100          #: kDefaultTickHz
 MAX_TICK_HZ = 10000            #: kMaxTickHz
@@ -89,6 +107,17 @@ def config_default():
         "fine_sigma0_att_rad": np.zeros(3),
         "fine_sigma0_gyro": 0.0,
         "fine_sigma0_accel": 0.0,
+        "index_scheme": INDEX_NONE,
+        "index_stop_ticks": 0,
+        "index_timeout_ticks": 0,
+        "index_n_steps": 0,
+        "index_rate_rad_s": 0.0,
+        "index_accel_rad_s2": 0.0,
+        "index_delta": 0.0,
+        "index_max_flex_rad": 0.0,
+        "index_tolerance_rad": 0.0,
+        "index_jump_rad": 0.0,
+        "index_steps": [],    # list of (stop_ticks, kind, angle_rad)
     }
 
 
@@ -120,7 +149,55 @@ def config_resolved(cfg):
         cfg["fine_sigma0_gyro"] = DEFAULT_FINE_SIGMA_GYRO
     if cfg["fine_sigma0_accel"] == 0.0:
         cfg["fine_sigma0_accel"] = DEFAULT_FINE_SIGMA_ACCEL
+    if cfg["index_scheme"] != INDEX_CUSTOM:
+        if cfg["index_stop_ticks"] == 0:
+            s = DEFAULT_STOP_SEED003_S if cfg["index_scheme"] == INDEX_SINGLE_FWD_REV else DEFAULT_STOP_S
+            cfg["index_stop_ticks"] = s * cfg["tick_hz"]
+        if cfg["index_rate_rad_s"] == 0.0:
+            cfg["index_rate_rad_s"] = DEFAULT_INDEX_RATE
+        if cfg["index_accel_rad_s2"] == 0.0:
+            cfg["index_accel_rad_s2"] = DEFAULT_INDEX_ACCEL
+        if cfg["index_delta"] == 0.0:
+            cfg["index_delta"] = DEFAULT_INDEX_DELTA
+    if cfg["index_max_flex_rad"] == 0.0:
+        cfg["index_max_flex_rad"] = DEFAULT_INDEX_MAX_FLEX
+    if cfg["index_tolerance_rad"] == 0.0:
+        cfg["index_tolerance_rad"] = DEFAULT_INDEX_TOLERANCE
+    if cfg["index_jump_rad"] == 0.0:
+        cfg["index_jump_rad"] = DEFAULT_INDEX_JUMP
+    if cfg["index_timeout_ticks"] == 0:
+        cfg["index_timeout_ticks"] = DEFAULT_INDEX_TIMEOUT_S * cfg["tick_hz"]
     return cfg
+
+
+def index_check(cfg):
+    """The indexing part of config_check (mirrors index_check)."""
+    scheme = cfg["index_scheme"]
+    if scheme < INDEX_NONE or scheme > INDEX_CUSTOM:
+        return PYINS_E_CONFIG_INDEX_SCHEME
+    if scheme == INDEX_NONE:
+        return PYINS_OK
+    flexible = scheme == INDEX_FLEXIBLE_TWO
+    if scheme == INDEX_CUSTOM:
+        n = cfg["index_n_steps"]
+        if n < 1 or n > indexing.MAX_STEPS:
+            return PYINS_E_CONFIG_INDEX_EMPTY
+        for stop, kind, angle in list(cfg["index_steps"])[:n]:
+            if (stop < 1 or not math.isfinite(angle) or kind not in (1, 2, 3)
+                    or (kind == indexing.KIND_FIXED and angle == 0.0) or abs(angle) > 16.0 * np.pi):
+                return PYINS_E_CONFIG_INDEX_STEP
+            flexible = flexible or kind != indexing.KIND_FIXED
+    elif cfg["index_stop_ticks"] < 1:
+        return PYINS_E_CONFIG_INDEX_STEP
+    rate, accel = cfg["index_rate_rad_s"], cfg["index_accel_rad_s2"]
+    if not (rate > 0.0) or not (accel > 0.0) or not math.isfinite(rate) or not math.isfinite(accel):
+        return PYINS_E_CONFIG_INDEX_RATE
+    if flexible and not (0.0 < cfg["index_delta"] < 1.0):
+        return PYINS_E_CONFIG_INDEX_DELTA
+    vals = [cfg["index_max_flex_rad"], cfg["index_tolerance_rad"], cfg["index_jump_rad"]]
+    if any(not (v > 0.0) or not math.isfinite(v) for v in vals) or cfg["index_timeout_ticks"] < 1:
+        return PYINS_E_CONFIG_INDEX_STEP
+    return PYINS_OK
 
 
 def _finite3(v):
@@ -168,7 +245,7 @@ def config_check(raw):
     for v in noise:
         if not (v > 0.0) or not math.isfinite(v):
             return PYINS_E_CONFIG_NOISE
-    return PYINS_OK
+    return index_check(cfg)
 
 
 def wrap_two_pi(a):
@@ -232,6 +309,18 @@ class Firmware:
                                  np.array(cfg["vel_n_mps"], dtype=float),
                                  attitude.mat_to_quat(mat_np))
         self.sd = strapdown.make_strapdown(nav, cfg["vertical_mode"])
+        if cfg["index_scheme"] == INDEX_CUSTOM:
+            steps = [indexing.Step(int(s), int(k), float(a))
+                     for s, k, a in list(cfg["index_steps"])[:cfg["index_n_steps"]]]
+        else:
+            steps = indexing.preset_steps(cfg["index_scheme"], cfg["index_stop_ticks"])
+        self.index_prm = indexing.Params(
+            steps=steps, rate=cfg["index_rate_rad_s"], accel=cfg["index_accel_rad_s2"],
+            delta=cfg["index_delta"], max_flex=cfg["index_max_flex_rad"],
+            tolerance=cfg["index_tolerance_rad"], jump=cfg["index_jump_rad"],
+            timeout_ticks=cfg["index_timeout_ticks"], dt=self.dt)
+        idle = indexing.Params(**{**self.index_prm.__dict__, "steps": []})
+        self.idx = indexing.init(idle, self.table_angle)
         self.coarse = None
         if cfg["coarse_ticks"] > 0:
             sin_lat, cos_lat = np.sin(cfg["lat_rad"]), np.cos(cfg["lat_rad"])
@@ -252,7 +341,7 @@ class Firmware:
         if self.cfg["fine_ticks"] > 0:
             self.start_fine()
         else:
-            self.mode = MODE_NAVIGATE
+            self.start_navigation()
 
     def start_fine(self):
         cfg = self.cfg
@@ -282,7 +371,23 @@ class Firmware:
 
     def end_fine(self):
         self.apply_fine_correction()
+        self.start_navigation()
+
+    def start_navigation(self):
         self.mode = MODE_NAVIGATE
+        self.idx = indexing.init(self.index_prm, self.table_angle)
+
+    def imu_yaw(self):
+        """psi_p = psi_b + alpha (mirrors Firmware::imu_yaw)."""
+        q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
+        w, x, y, z = attitude.quat_mul(self.sd.nav.quat_np, q_pb)
+        c01 = 2.0 * (x * y - w * z)
+        c11 = w * w - x * x + y * y - z * z
+        return wrap_pi(np.arctan2(-c01, c11) + self.encoder)
+
+    def index_reset(self):
+        if self.idx.state == indexing.STATE_FAULT:
+            self.idx = indexing.reset(self.idx, self.table_angle)
 
     def hold_at_site(self):
         self.sd.nav.lat = self.cfg["lat_rad"]
@@ -300,6 +405,12 @@ class Firmware:
             return PYINS_E_SAMPLE_NONFINITE, self.output()
         dtheta_p = np.asarray(dtheta_p, dtype=float)
         dv_p = np.asarray(dv_p, dtype=float)
+        encoder = wrap_two_pi(table_angle_rad)
+        self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
+        if encoder != self.encoder:   # the table moved: refresh the cached half-angle
+            self.encoder = encoder
+            self.enc_sin_half = math.sin(0.5 * self.encoder)
+            self.enc_cos_half = math.cos(0.5 * self.encoder)
         if self.gap_pending:
             self.gap_pending = False
             self.align_restarts = self.align_restarts + 1
@@ -315,7 +426,7 @@ class Firmware:
             elif self.cfg["fine_ticks"] > 0:
                 self.start_fine()
             else:
-                self.mode = MODE_NAVIGATE
+                self.start_navigation()
         if self.mode == MODE_COARSE_ALIGN:
             coarse_align.update(self.coarse, dtheta_p, dv_p)
             if self.coarse.tick == self.cfg["coarse_ticks"]:
@@ -333,12 +444,8 @@ class Firmware:
                 self.end_fine()
         else:
             strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
-        encoder = wrap_two_pi(table_angle_rad)
-        self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
-        if encoder != self.encoder:   # the table moved: refresh the cached half-angle
-            self.encoder = encoder
-            self.enc_sin_half = math.sin(0.5 * self.encoder)
-            self.enc_cos_half = math.cos(0.5 * self.encoder)
+            if self.index_prm.n_steps > 0:
+                indexing.update(self.idx, self.table_angle, self.imu_yaw())
         self.tick = self.tick + 1
         return PYINS_OK, self.output()
 
@@ -370,6 +477,14 @@ class Firmware:
             "heading_b_rad": attitude.yaw_to_heading(euler_b[2]),
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),
             "table_angle_rad": self.table_angle,
+            "index_state": self.idx.state,
+            "index_step": self.idx.step,
+            "index_fault": self.idx.fault,
+            "index_fallbacks": self.idx.fallbacks,
+            "motor_rate_cmd_rad_s": self.idx.cmd_rate,
+            "table_angle_cmd_rad": self.idx.cmd_angle,
+            "index_a_c": self.idx.a_c,
+            "index_a_s": self.idx.a_s,
             "kf_states": self.kf_states,
             "align_restarts": self.align_restarts,
             "kf_x": self._kf(lambda f: f.x),

@@ -70,7 +70,10 @@ int main(void) {
                              PYINS_E_CONFIG_VEL, PYINS_E_CONFIG_ATT, PYINS_E_CONFIG_MODE,
                              PYINS_E_CONFIG_ALIGN_RATIO, PYINS_E_CONFIG_ALIGN_EARLY,
                              PYINS_E_CONFIG_ALIGN_LONG, PYINS_E_CONFIG_ALIGN_TICKS,
-                             PYINS_E_CONFIG_FINE, PYINS_E_CONFIG_NOISE};
+                             PYINS_E_CONFIG_FINE, PYINS_E_CONFIG_NOISE,
+                             PYINS_E_CONFIG_INDEX_SCHEME, PYINS_E_CONFIG_INDEX_EMPTY,
+                             PYINS_E_CONFIG_INDEX_RATE, PYINS_E_CONFIG_INDEX_DELTA,
+                             PYINS_E_CONFIG_INDEX_STEP};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
         int distinct = 1;
@@ -139,6 +142,25 @@ int main(void) {
     BAD_CFG((b.fine_ticks = 1000, b.fine_gyro_arw = -1e-6), PYINS_E_CONFIG_NOISE, "negative gyro ARW");
     BAD_CFG((b.fine_ticks = 1000, b.fine_accel_vrw = NAN), PYINS_E_CONFIG_NOISE, "NaN accel VRW");
     BAD_CFG((b.fine_ticks = 1000, b.fine_sigma0_att_rad[2] = -1.0), PYINS_E_CONFIG_NOISE, "negative sigma0");
+    BAD_CFG(b.index_scheme = 9, PYINS_E_CONFIG_INDEX_SCHEME, "unknown indexing scheme");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 0), PYINS_E_CONFIG_INDEX_EMPTY,
+            "empty custom scheme");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 1, b.index_steps[0].stop_ticks = 100,
+             b.index_steps[0].kind = PYINS_INDEX_FIXED, b.index_steps[0].angle_rad = 3.14,
+             b.index_rate_rad_s = 0.0, b.index_accel_rad_s2 = 1.0, b.index_delta = 0.01),
+            PYINS_E_CONFIG_INDEX_RATE, "custom scheme with zero rate");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 1, b.index_steps[0].stop_ticks = 100,
+             b.index_steps[0].kind = PYINS_INDEX_FLEX_COS, b.index_steps[0].angle_rad = 1.0,
+             b.index_rate_rad_s = 0.1, b.index_accel_rad_s2 = 1.0, b.index_delta = 0.0),
+            PYINS_E_CONFIG_INDEX_DELTA, "flexible custom scheme with delta 0");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_FLEXIBLE_TWO, b.index_delta = -0.01), PYINS_E_CONFIG_INDEX_DELTA,
+            "negative delta");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_TWO_POSITION, b.index_rate_rad_s = -0.1), PYINS_E_CONFIG_INDEX_RATE,
+            "negative rate");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 1, b.index_steps[0].stop_ticks = 0,
+             b.index_steps[0].kind = PYINS_INDEX_FIXED, b.index_steps[0].angle_rad = 3.14,
+             b.index_rate_rad_s = 0.1, b.index_accel_rad_s2 = 1.0), PYINS_E_CONFIG_INDEX_STEP,
+            "custom step with no stop");
 
     /* init: NULL, misaligned, too small. */
     check_status(pyins_init(NULL, size, &cfg), PYINS_E_NULL, "init NULL mem");
