@@ -22,7 +22,8 @@ from ._cdef import read_cdef
 EXPECTED_ABI = (0, 5)
 
 _LIB_NAME = "libpyins_core.so"
-_HEADERS = ("pyins_core.h", "pyins_core_testing.h")
+_HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")
+_PLANT_NAME = "libpyins_plant.so"
 _REBUILD = "run `pip install .` (or `bash tools/setup.sh`) in the pyins source tree to build it"
 
 
@@ -38,10 +39,10 @@ def _locate():
         where = f"PYINS_CORE_LIB={override}" if override else "inside the installed pyins package"
         raise ImportError(f"pyins: the firmware core library {_LIB_NAME} was not found {where}; {_REBUILD}.")
     texts = {}
-    source_include = Path(__file__).resolve().parent.parent / "csrc" / "include"
+    source = Path(__file__).resolve().parent.parent / "csrc"
     for name in _HEADERS:
         candidates = [Path(str(lib_path)).parent / name] if override else [_package_file(name)]
-        candidates.append(source_include / name)
+        candidates.append(source / ("plant" if name == "pyins_plant.h" else "include") / name)
         for c in candidates:
             if c.is_file():
                 texts[name] = c.read_text()
@@ -81,10 +82,15 @@ def _load():
             lib.pyins_t_sin  # noqa: B018  (the library may be built without hooks)
         except AttributeError:
             has_hooks = False
-    return ffi, lib, lib_path, has_hooks
+    plant = None
+    plant_path = Path(str(lib_path)).parent / _PLANT_NAME
+    if "pyins_plant.h" in texts and plant_path.is_file():
+        ffi.cdef(read_cdef(texts["pyins_plant.h"]))
+        plant = ffi.dlopen(str(plant_path))
+    return ffi, lib, lib_path, has_hooks, plant
 
 
-ffi, lib, LIBRARY_PATH, HAS_TEST_HOOKS = _load()
+ffi, lib, LIBRARY_PATH, HAS_TEST_HOOKS, plant = _load()
 
 _PRIMITIVE = {"double": "<f8", "int64_t": "<i8", "int32_t": "<i4", "uint32_t": "<u4",
               "uint64_t": "<u8", "uint8_t": "u1"}

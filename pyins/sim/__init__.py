@@ -16,7 +16,7 @@ Euler [pitch, roll, yaw], C_b^n = Rz(yaw) Rx(pitch) Ry(roll); SI inside. The
 Earth model is ``pyins.reference.earth``, the same as the firmware's.
 """
 from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, euler_to_quat,
-                           exact_increments, generate, truth, truth_at)
+                           exact_increments, generate, node_rates, truth, truth_at)
 from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
                           save_npz)
 from pyins.sim.motion import (SEA_STATES, ConstantRate, Fixed, HeadingSwing, Manoeuvre, Motion,
@@ -26,7 +26,7 @@ from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
 
 __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
-    "exact_increments", "generate", "truth", "truth_at",
+    "exact_increments", "generate", "node_rates", "truth", "truth_at",
     "CSV_COLUMNS", "CSV_HEADER", "ImuData", "load_csv", "load_npz", "save_csv", "save_npz",
     "SEA_STATES", "ConstantRate", "Fixed", "HeadingSwing", "Manoeuvre", "Motion",
     "MotionState", "Segment", "Static", "Swing", "TableMotion", "default_segments", "sea_state",

@@ -225,6 +225,23 @@ def _increments_block(motion, ticks, dt, t0, table, x, w):
     return half * dtheta, half * dv
 
 
+def node_rates(motion, ticks, dt=0.01, t0=0.0, nodes=5):
+    """The ship's omega_ib^b and f^b at the Gauss-Legendre nodes of ticks.
+
+    Returns ``(omega (n, nodes, 3), force (n, nodes, 3), x, w)`` with x, w the
+    abscissae on [-1, 1] and weights: what the firmware-in-the-loop plant
+    (pyins_plant.h) integrates after turning them into the IMU frame.
+    """
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    ticks = np.asarray(ticks, dtype=np.int64)
+    s = 0.5 * (1.0 + x)
+    t_hi, t_lo = split_times(ticks[:, None], dt, t0, s[None, :])
+    st = motion.state(t_hi.ravel(), t_lo.ravel())
+    omega, force = body_rate_and_force(st)
+    n = len(ticks)
+    return omega.reshape(n, nodes, 3), force.reshape(n, nodes, 3), x, w
+
+
 def _table_angle_end(table, ticks, dt, t0):
     if table is None:
         return np.zeros(len(ticks))

@@ -1,0 +1,157 @@
+// plant.cpp: the closed loop of pyins_plant.h. Host only; mirrored by
+// pyins/sim/turntable.py (same per-tick order of operations).
+#include "pyins_plant.h"
+
+#include <cmath>
+
+namespace {
+
+constexpr int kMaxNodes = 16;
+
+/// The table's acceleration over one tick: reach the commanded rate within
+/// the tick if the motor's limits allow (a rate loop with one-tick response).
+double table_accel(const pyins_table_config& cfg, const pyins_plant_state& st, double dt) {
+    double cmd = st.rate_cmd_rad_s;
+    const bool active = cfg.fault != PYINS_TABLE_OK && st.tick >= cfg.fault_tick;
+    if (active && cfg.fault == PYINS_TABLE_STALL) {
+        cmd = 0.0;
+    } else if (active && cfg.fault == PYINS_TABLE_REVERSE) {
+        cmd = -cmd;
+    }
+    if (cmd > cfg.rate_max_rad_s) {
+        cmd = cfg.rate_max_rad_s;
+    } else if (cmd < -cfg.rate_max_rad_s) {
+        cmd = -cfg.rate_max_rad_s;
+    }
+    double a = (cmd - st.rate_rad_s) / dt;
+    if (a > cfg.accel_max_rad_s2) {
+        a = cfg.accel_max_rad_s2;
+    } else if (a < -cfg.accel_max_rad_s2) {
+        a = -cfg.accel_max_rad_s2;
+    }
+    return a;
+}
+
+void apply_errors(const double m[9], const double bias[3], double quantum, const double* noise,
+                  double dt, double res[3], const double in[3], double out[3]) {
+    for (int i = 0; i < 3; ++i) {
+        double v = m[3 * i] * in[0] + m[3 * i + 1] * in[1] + m[3 * i + 2] * in[2] + bias[i] * dt;
+        if (noise != nullptr) {
+            v = v + noise[i];
+        }
+        if (quantum > 0.0) {
+            const double total = v + res[i];
+            const double q = quantum * std::nearbyint(total / quantum);
+            res[i] = total - q;
+            v = q;
+        }
+        out[i] = v;
+    }
+}
+
+double wrap_two_pi(double a) {
+    constexpr double kTwoPi = 6.283185307179586476925286766559;
+    double w = a - kTwoPi * std::floor(a / kTwoPi);
+    if (w >= kTwoPi) {
+        w = 0.0;
+    }
+    return w;
+}
+
+}  // namespace
+
+extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyins_table_config* table,
+                             const pyins_imu_errors* err, const double* node_omega_b,
+                             const double* node_force_b, const double* node_x, const double* node_w,
+                             int32_t n_nodes, int64_t period, int64_t phase0, const double* gyro_noise,
+                             const double* accel_noise, size_t n, double dt, size_t every,
+                             pyins_output* outputs, pyins_plant_record* records, size_t capacity,
+                             size_t* n_done, size_t* n_out) {
+    if (n_done != nullptr) {
+        *n_done = 0;
+    }
+    if (n_out != nullptr) {
+        *n_out = 0;
+    }
+    if (core == nullptr || st == nullptr || table == nullptr || err == nullptr ||
+        node_omega_b == nullptr || node_force_b == nullptr || node_x == nullptr || node_w == nullptr ||
+        (capacity > 0 && (outputs == nullptr || records == nullptr))) {
+        return PYINS_E_NULL;
+    }
+    if (n_nodes < 1 || n_nodes > kMaxNodes || period < 1 || phase0 < 0 || !(dt > 0.0) || every == 0) {
+        return PYINS_E_BAD_ARG;
+    }
+    if (capacity < n / every + 1) {
+        return PYINS_E_BUFFER_TOO_SMALL;
+    }
+    const double half = 0.5 * dt;
+    size_t written = 0;
+    pyins_output out;
+    for (size_t k = 0; k < n; ++k) {
+        const int64_t base = ((phase0 + static_cast<int64_t>(k)) % period) * n_nodes;
+        const double a = table_accel(*table, *st, dt);
+        double dtheta[3] = {0.0, 0.0, 0.0};
+        double dv[3] = {0.0, 0.0, 0.0};
+        for (int32_t j = 0; j < n_nodes; ++j) {
+            const double tau = 0.5 * (1.0 + node_x[j]) * dt;
+            const double alpha = st->alpha_rad + st->rate_rad_s * tau + 0.5 * a * tau * tau;
+            const double alpha_dot = st->rate_rad_s + a * tau;
+            const double c = std::cos(alpha);
+            const double s = std::sin(alpha);
+            const double* w_b = node_omega_b + 3 * (base + j);
+            const double* f_b = node_force_b + 3 * (base + j);
+            // omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot z;  f^p = Rz(alpha)^T f^b
+            dtheta[0] = dtheta[0] + node_w[j] * (c * w_b[0] + s * w_b[1]);
+            dtheta[1] = dtheta[1] + node_w[j] * (-s * w_b[0] + c * w_b[1]);
+            dtheta[2] = dtheta[2] + node_w[j] * (w_b[2] + alpha_dot);
+            dv[0] = dv[0] + node_w[j] * (c * f_b[0] + s * f_b[1]);
+            dv[1] = dv[1] + node_w[j] * (-s * f_b[0] + c * f_b[1]);
+            dv[2] = dv[2] + node_w[j] * f_b[2];
+        }
+        for (int i = 0; i < 3; ++i) {
+            dtheta[i] = half * dtheta[i];
+            dv[i] = half * dv[i];
+        }
+        st->alpha_rad = st->alpha_rad + st->rate_rad_s * dt + 0.5 * a * dt * dt;
+        st->rate_rad_s = st->rate_rad_s + a * dt;
+        st->tick = st->tick + 1;
+
+        pyins_sample sample;
+        apply_errors(err->gyro_m, err->gyro_bias_rad_s, err->gyro_quantum_rad,
+                     gyro_noise != nullptr ? gyro_noise + 3 * k : nullptr, dt, st->gyro_residual,
+                     dtheta, sample.dtheta_p_rad);
+        apply_errors(err->accel_m, err->accel_bias_mps2, err->accel_quantum_mps,
+                     accel_noise != nullptr ? accel_noise + 3 * k : nullptr, dt, st->accel_residual, dv,
+                     sample.dv_p_mps);
+        double enc = st->alpha_rad;
+        if (table->fault == PYINS_TABLE_JUMP && st->tick > table->fault_tick) {
+            enc = enc + table->jump_rad;
+        }
+        enc = wrap_two_pi(enc);
+        if (table->encoder_lsb_rad > 0.0) {
+            enc = table->encoder_lsb_rad * std::floor(enc / table->encoder_lsb_rad);
+        }
+        sample.table_angle_rad = enc;
+
+        const int status = pyins_step(core, &sample, &out);
+        if (status != PYINS_OK) {
+            return status;
+        }
+        st->rate_cmd_rad_s = out.motor_rate_cmd_rad_s;
+        if (n_done != nullptr) {
+            *n_done = k + 1;
+        }
+        if (static_cast<uint64_t>(st->tick) % static_cast<uint64_t>(every) == 0u) {
+            outputs[written] = out;
+            records[written].tick = st->tick;
+            records[written].alpha_rad = st->alpha_rad;
+            records[written].rate_rad_s = st->rate_rad_s;
+            records[written].encoder_rad = enc;
+            written = written + 1;
+            if (n_out != nullptr) {
+                *n_out = written;
+            }
+        }
+    }
+    return PYINS_OK;
+}

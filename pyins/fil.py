@@ -1,0 +1,153 @@
+"""Firmware-in-the-loop runs: the C++ firmware closing the loop through a
+simulated turntable, over hours or days of ship time.
+
+The ship's motion is open loop (it does not feel the table): its body rate
+and specific force at the quadrature nodes of every tick come from
+``pyins.sim`` in NumPy, once per period for periodic profiles (static,
+swings, heading swings) or chunk by chunk otherwise. The closed loop itself,
+per tick (firmware command -> motor -> table angle inside the tick ->
+increments of the turning IMU -> sensor errors -> firmware), runs in the
+compiled plant (``csrc/plant``, mirrored by ``pyins.sim.turntable``). Only
+decimated records (every ``every`` ticks) come back, so memory stays bounded
+for any duration.
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pyins import native, runner, sim
+from pyins.sim.turntable import TableConfig, error_matrices
+
+
+@dataclass
+class FilResult:
+    outputs: np.ndarray       #: firmware OUTPUT_DTYPE records at the kept ticks
+    plant: np.ndarray         #: PLANT_RECORD_DTYPE: true table angle, rate, encoder
+    truth: sim.Truth          #: the ship's true state at the kept ticks
+    dt: float
+
+
+PLANT_RECORD_DTYPE = np.dtype([("tick", "<i8"), ("alpha_rad", "<f8"), ("rate_rad_s", "<f8"),
+                               ("encoder_rad", "<f8")])
+
+
+def periodic_ticks(motion, dt, limit=2_000_000):
+    """Ticks after which the ship's body rate and force repeat exactly, or
+    None. Static: 1. Swings: the least common multiple of each active
+    frequency's whole-tick period (at most 1000 cycles)."""
+    if isinstance(motion, sim.Static):
+        return 1
+    if not isinstance(motion, sim.Swing):
+        return None
+    period = 1
+    for amp, f in zip(motion.amplitude, motion.frequency_hz):
+        if amp == 0.0 or f == 0.0:
+            continue
+        ticks_per_cycle = 1.0 / (f * dt)
+        for cycles in range(1, 1001):
+            p = cycles * ticks_per_cycle
+            if abs(p - round(p)) < 1e-9 * p:
+                break
+        else:
+            return None
+        period = math.lcm(period, int(round(p)))
+        if period > limit:
+            return None
+    return period
+
+
+def _errors_struct(errors):
+    e = native.ffi.new("pyins_imu_errors *")
+    m = error_matrices(errors)
+    for i in range(9):
+        e.gyro_m[i] = m["gyro_m"].ravel()[i]
+        e.accel_m[i] = m["accel_m"].ravel()[i]
+    for i in range(3):
+        e.gyro_bias_rad_s[i] = m["gyro_bias"][i]
+        e.accel_bias_mps2[i] = m["accel_bias"][i]
+    e.gyro_quantum_rad = m["gyro_quantum"]
+    e.accel_quantum_mps = m["accel_quantum"]
+    return e
+
+
+def _table_struct(table):
+    t = native.ffi.new("pyins_table_config *")
+    t.rate_max_rad_s, t.accel_max_rad_s2 = table.rate_max_rad_s, table.accel_max_rad_s2
+    t.encoder_lsb_rad, t.jump_rad = table.encoder_lsb_rad, table.jump_rad
+    t.fault_tick, t.fault = table.fault_tick, table.fault
+    return t
+
+
+def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
+            chunk_ticks=500_000, dt=0.01, nodes=5, progress=None):
+    """Run the closed loop for ``duration_ticks``.
+
+    ``config``: firmware configuration overrides (default: the true initial
+    state, table at 0, no alignment, no indexing); ``errors``: a
+    ``pyins.sim.SensorErrors`` (None: error-free) with noise drawn from
+    ``seed`` exactly as ``pyins.sim.SensorModel`` draws it; ``table``: a
+    ``TableConfig``. ``progress(done_ticks, total_ticks)`` is called after
+    every chunk. Returns a FilResult.
+    """
+    if native.plant is None:
+        raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
+    ffi = native.ffi
+    errors = errors if errors is not None else sim.SensorErrors()
+    table = table if table is not None else TableConfig()
+    cfg = runner.initial_config(motion, None, **(config or {}))
+    fw = native.Firmware(cfg)
+    st = ffi.new("pyins_plant_state *")
+    st.alpha_rad = cfg.get("table_angle_rad", 0.0)
+    err_c = _errors_struct(errors)
+    tab_c = _table_struct(table)
+    rng = np.random.default_rng(seed)
+    noisy = errors.gyro_arw > 0.0 or errors.accel_vrw > 0.0
+    sq = math.sqrt(dt)
+
+    period = periodic_ticks(motion, dt)
+    if period is not None:
+        omega, force, x, w = sim.node_rates(motion, np.arange(period), dt=dt, nodes=nodes)
+        omega, force = np.ascontiguousarray(omega), np.ascontiguousarray(force)
+    x_c = w_c = None
+    outs, recs = [], []
+    n_done_p = ffi.new("size_t *")
+    n_out_p = ffi.new("size_t *")
+    done = 0
+    while done < duration_ticks:
+        n = min(chunk_ticks, duration_ticks - done)
+        if period is None:
+            omega, force, x, w = sim.node_rates(motion, np.arange(done, done + n), dt=dt, nodes=nodes)
+            omega, force = np.ascontiguousarray(omega), np.ascontiguousarray(force)
+            per, phase0 = n, 0
+        else:
+            per, phase0 = period, done % period
+        x_c, w_c = np.ascontiguousarray(x), np.ascontiguousarray(w)
+        if noisy:
+            z = rng.standard_normal((n, 6))
+            g_noise = np.ascontiguousarray((errors.gyro_arw * sq) * z[:, :3])
+            a_noise = np.ascontiguousarray((errors.accel_vrw * sq) * z[:, 3:])
+            g_ptr = ffi.from_buffer("double[]", g_noise)
+            a_ptr = ffi.from_buffer("double[]", a_noise)
+        else:
+            g_ptr = a_ptr = ffi.NULL
+        cap = n // every + 1
+        out = np.empty(cap, dtype=native.OUTPUT_DTYPE)
+        rec = np.empty(cap, dtype=PLANT_RECORD_DTYPE)
+        status = native.plant.pyins_fil_run(
+            fw.core, st, tab_c, err_c, ffi.from_buffer("double[]", omega), ffi.from_buffer("double[]", force),
+            ffi.from_buffer("double[]", x_c), ffi.from_buffer("double[]", w_c), len(x_c), per, phase0,
+            g_ptr, a_ptr, n, dt, every, ffi.from_buffer("pyins_output[]", out, require_writable=True),
+            ffi.cast("pyins_plant_record *", ffi.from_buffer(rec, require_writable=True)), cap,
+            n_done_p, n_out_p)
+        outs.append(out[:n_out_p[0]].copy())
+        recs.append(rec[:n_out_p[0]].copy())
+        if status != 0:
+            raise native.CoreError(status, f"pyins_fil_run at tick {done + n_done_p[0]}")
+        done += n
+        if progress is not None:
+            progress(done, duration_ticks)
+    outputs = np.concatenate(outs)
+    plant = np.concatenate(recs)
+    truth = sim.truth_at(motion, outputs["tick"], dt=dt)
+    return FilResult(outputs=outputs, plant=plant, truth=truth, dt=dt)
