@@ -56,3 +56,98 @@ def reduced_truth(limits, phi_true=np.zeros(3)):
     phi_hat = np.asarray(phi_true, dtype=float) - limits.phi_n
     eps_hat = limits.eps_n[1:] - limits.eps_n_limit[1:]
     return np.concatenate([phi_hat, eps_hat])
+
+
+# ---------------------------------------------------------------------------
+# Linear error model of a static INS (an error-budget tool)
+# ---------------------------------------------------------------------------
+@dataclass
+class StaticErrors:
+    """Errors predicted by the linear model at the times asked for."""
+    time_s: np.ndarray
+    att_n_rad: np.ndarray    #: phi (E, N, U), (N, 3), same sign as runner.NavErrors
+    vel_n_mps: np.ndarray    #: (N, 2) east, north
+    north_m: np.ndarray
+    east_m: np.ndarray
+    horizontal_m: np.ndarray
+
+
+def static_error_model(lat, times_s, eps_n, nabla_n=None, height=0.0, step_s=0.5):
+    """Propagate the linear phi-angle error equations of a static INS.
+
+    Qin Yongyuan, "Inertial Navigation" (2014), sec. 4.2 (ENU, psi = 0 ship
+    at rest, vertical channel held):
+
+        phi'  = -omega_ie x phi + d_omega_in - eps^n
+                d_omega_in = [-dvN/RM, dvE/RN - W sinL dL, dvE tanL/RN + W cosL dL]
+        dvE'  = -g phi_N + 2 W sinL dvN + nabla_E
+        dvN'  =  g phi_E - 2 W sinL dvE + nabla_N
+        dL'   = dvN / RM,   dlambda' = dvE / (RN cosL)
+
+    with its Schuler (84 min), Earth-rate (24 h) and Foucault couplings.
+    ``eps_n`` is the gyro drift in n [rad/s]: a 3-vector, or a function that
+    maps an array of times (N,) to drifts (N, 3) (a rotating IMU:
+    C_p^n(t) eps^p); ``nabla_n`` likewise for the accelerometer bias (E, N
+    used). Integrated by fourth-order Runge-Kutta with ``step_s`` (the
+    inputs are sampled on the half-step grid); returns StaticErrors at
+    ``times_s``.
+    """
+    times_s = np.asarray(times_s, dtype=float)
+    half = 0.5 * step_s
+    grid = np.arange(0.0, times_s.max() + 2 * step_s, half)
+
+    def sampled(src):
+        if src is None:
+            return np.zeros((len(grid), 3))
+        if callable(src):
+            return np.asarray(src(grid), dtype=float).reshape(len(grid), 3)
+        return np.tile(np.asarray(src, dtype=float), (len(grid), 1))
+
+    eps_grid = sampled(eps_n)
+    nab_grid = sampled(nabla_n)
+
+    def eps_f(t):
+        return eps_grid[int(round(t / half))]
+
+    def nab_f(t):
+        return nab_grid[int(round(t / half))]
+    sin_lat, cos_lat = np.sin(lat), np.cos(lat)
+    rm, rn = earth.principal_radii(sin_lat)
+    rm_h, rn_h = rm + height, rn + height
+    g = earth.normal_gravity(sin_lat, height)
+    w = earth.OMEGA_IE
+    w_n, w_u = w * cos_lat, w * sin_lat
+
+    def f(t, x):
+        phi_e, phi_n, phi_u, dve, dvn, dlat, _ = x
+        eps = eps_f(t)
+        nab = nab_f(t)
+        return np.array([
+            w_u * phi_n - w_n * phi_u - dvn / rm_h - eps[0],
+            -w_u * phi_e + dve / rn_h - w_u * dlat - eps[1],
+            w_n * phi_e + dve * np.tan(lat) / rn_h + w_n * dlat - eps[2],
+            -g * phi_n + 2.0 * w_u * dvn + nab[0],
+            g * phi_e - 2.0 * w_u * dve + nab[1],
+            dvn / rm_h,
+            dve / (rn_h * cos_lat),
+        ])
+
+    x = np.zeros(7)
+    t = 0.0
+    out = np.zeros((len(times_s), 7))
+    for i, target in enumerate(times_s):
+        while t < target - 1e-9:
+            h = step_s
+            if target - t < step_s - 1e-9:
+                raise ValueError(f"times_s must be multiples of step_s ({step_s} s); got {target}")
+            k1 = f(t, x)
+            k2 = f(t + 0.5 * h, x + 0.5 * h * k1)
+            k3 = f(t + 0.5 * h, x + 0.5 * h * k2)
+            k4 = f(t + h, x + h * k3)
+            x = x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            t = t + h
+        out[i] = x
+    north = out[:, 5] * rm_h
+    east = out[:, 6] * rn_h * cos_lat
+    return StaticErrors(time_s=times_s, att_n_rad=out[:, :3], vel_n_mps=out[:, 3:5], north_m=north,
+                        east_m=east, horizontal_m=np.hypot(north, east))
