@@ -11,7 +11,11 @@ compiled plant (``csrc/plant``, mirrored by ``pyins.sim.turntable``). Only
 decimated records (every ``every`` ticks) come back, so memory stays bounded
 for any duration.
 """
+import json
 import math
+import os
+import sys
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +34,31 @@ class FilResult:
 
 PLANT_RECORD_DTYPE = np.dtype([("tick", "<i8"), ("alpha_rad", "<f8"), ("rate_rad_s", "<f8"),
                                ("encoder_rad", "<f8")])
+
+
+class TextProgress:
+    """A one-line progress bar on stderr: ship time done, ticks per second,
+    time left. Silent when stderr is not a terminal (CI, pipes)."""
+
+    def __init__(self, dt=0.01, stream=None, width=30):
+        self.dt, self.width = dt, width
+        self.stream = stream if stream is not None else sys.stderr
+        self.t0 = time.perf_counter()
+        self.active = hasattr(self.stream, "isatty") and self.stream.isatty()
+
+    def __call__(self, done, total):
+        if not self.active:
+            return
+        el = time.perf_counter() - self.t0
+        rate = done / el if el > 0 else 0.0
+        left = (total - done) / rate if rate > 0 else float("nan")
+        n = int(self.width * done / total)
+        self.stream.write(f"\r[{'#' * n}{'.' * (self.width - n)}] {done * self.dt / 3600:.2f}/"
+                          f"{total * self.dt / 3600:.2f} h ship time, {rate / 1e6:.2f} M ticks/s, "
+                          f"{left:.0f} s left ")
+        if done >= total:
+            self.stream.write("\n")
+        self.stream.flush()
 
 
 def periodic_ticks(motion, dt, limit=2_000_000):
@@ -80,7 +109,7 @@ def _table_struct(table):
 
 
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
-            chunk_ticks=500_000, dt=0.01, nodes=5, progress=None):
+            chunk_ticks=500_000, dt=0.01, nodes=5, progress=None, record_dir=None):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -88,7 +117,11 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     ``pyins.sim.SensorErrors`` (None: error-free) with noise drawn from
     ``seed`` exactly as ``pyins.sim.SensorModel`` draws it; ``table``: a
     ``TableConfig``. ``progress(done_ticks, total_ticks)`` is called after
-    every chunk. Returns a FilResult.
+    every chunk (``TextProgress()`` draws a bar). With ``record_dir`` the
+    decimated records are streamed to ``outputs.bin`` and ``plant.bin`` there
+    (raw OUTPUT_DTYPE / PLANT_RECORD_DTYPE, described in ``records.json``)
+    chunk by chunk and returned memory-mapped, so memory stays bounded for
+    any duration. Returns a FilResult.
     """
     if native.plant is None:
         raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
@@ -111,6 +144,11 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         omega, force = np.ascontiguousarray(omega), np.ascontiguousarray(force)
     x_c = w_c = None
     outs, recs = [], []
+    sinks = None
+    if record_dir is not None:
+        os.makedirs(record_dir, exist_ok=True)
+        sinks = (open(os.path.join(record_dir, "outputs.bin"), "wb"),
+                 open(os.path.join(record_dir, "plant.bin"), "wb"))
     n_done_p = ffi.new("size_t *")
     n_out_p = ffi.new("size_t *")
     done = 0
@@ -140,14 +178,31 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             g_ptr, a_ptr, n, dt, every, ffi.from_buffer("pyins_output[]", out, require_writable=True),
             ffi.cast("pyins_plant_record *", ffi.from_buffer(rec, require_writable=True)), cap,
             n_done_p, n_out_p)
-        outs.append(out[:n_out_p[0]].copy())
-        recs.append(rec[:n_out_p[0]].copy())
+        if sinks is not None:
+            sinks[0].write(out[:n_out_p[0]].tobytes())
+            sinks[1].write(rec[:n_out_p[0]].tobytes())
+        else:
+            outs.append(out[:n_out_p[0]].copy())
+            recs.append(rec[:n_out_p[0]].copy())
         if status != 0:
+            if sinks is not None:
+                for f in sinks:
+                    f.close()
             raise native.CoreError(status, f"pyins_fil_run at tick {done + n_done_p[0]}")
         done += n
         if progress is not None:
             progress(done, duration_ticks)
-    outputs = np.concatenate(outs)
-    plant = np.concatenate(recs)
-    truth = sim.truth_at(motion, outputs["tick"], dt=dt)
+    if sinks is not None:
+        for f in sinks:
+            f.close()
+        with open(os.path.join(record_dir, "records.json"), "w") as f:
+            json.dump({"outputs.bin": str(native.OUTPUT_DTYPE.descr),
+                       "plant.bin": str(PLANT_RECORD_DTYPE.descr),
+                       "every_ticks": every, "dt_s": dt, "ticks": int(duration_ticks)}, f, indent=2)
+        outputs = np.memmap(os.path.join(record_dir, "outputs.bin"), dtype=native.OUTPUT_DTYPE, mode="r")
+        plant = np.memmap(os.path.join(record_dir, "plant.bin"), dtype=PLANT_RECORD_DTYPE, mode="r")
+    else:
+        outputs = np.concatenate(outs)
+        plant = np.concatenate(recs)
+    truth = sim.truth_at(motion, np.asarray(outputs["tick"]), dt=dt)
     return FilResult(outputs=outputs, plant=plant, truth=truth, dt=dt)

@@ -65,7 +65,8 @@ def main(argv=None):
                 cfg = dict(index_scheme=scheme)
                 if row == 0:
                     cfg.update(initial_errors(m))
-                res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=args.seed, every=100)
+                res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=args.seed, every=100,
+                                  progress=fil.TextProgress())
                 e = runner.nav_errors(res)
                 fin, mx = e.horizontal_m[-1] / earth.NMI_TO_M, e.horizontal_m.max() / earth.NMI_TO_M
                 key = f"exp{exp}_{'table2' if row == 0 else 'hdrift'}_{label.split()[0]}"

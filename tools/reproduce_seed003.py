@@ -48,7 +48,8 @@ def main(argv=None):
     rows = []
     fg, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
     for scheme, label in ((0, "no rotation"), (1, "single-position fwd/rev (seed 003)")):
-        res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed, every=100)
+        res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed,
+                          every=100, progress=fil.TextProgress())
         e = runner.nav_errors(res)
         th = e.time_s / 3600
         figs = {

@@ -45,3 +45,36 @@ def test_table_faults_detected_within_configured_time(fault, code):
         # 150-tick timeout after the lag exceeds 0.5 deg (under 0.2 s)
         assert 30_000 <= first_fault <= 30_000 + 150 + 25
     assert np.all(o["mode"][first_fault:] == 3) and np.all(np.isfinite(o["lat_rad"]))
+
+
+def test_records_streamed_to_disk_equal_in_memory(tmp_path):
+    m = sim.HeadingSwing.experiment(2)
+    a = fil.run_fil(m, 50_000, config=dict(index_scheme=4, index_stop_ticks=1000), every=10,
+                    chunk_ticks=7_000)
+    b = fil.run_fil(m, 50_000, config=dict(index_scheme=4, index_stop_ticks=1000), every=10,
+                    chunk_ticks=7_000, record_dir=tmp_path)
+    assert isinstance(b.outputs, np.memmap)
+    assert np.asarray(b.outputs).tobytes() == a.outputs.tobytes()
+    assert np.asarray(b.plant).tobytes() == a.plant.tobytes()
+    assert (tmp_path / "records.json").exists()
+    # chunking does not change the run: one chunk gives the same bits
+    c = fil.run_fil(m, 50_000, config=dict(index_scheme=4, index_stop_ticks=1000), every=10)
+    assert c.outputs.tobytes() == a.outputs.tobytes()
+
+
+def test_text_progress_draws_on_a_terminal():
+    import io
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    s = Tty()
+    p = fil.TextProgress(stream=s)
+    p(180_000, 360_000)
+    p(360_000, 360_000)
+    text = s.getvalue()
+    assert "0.50/1.00 h ship time" in text and text.endswith("\n")
+    quiet = io.StringIO()
+    fil.TextProgress(stream=quiet)(1, 2)
+    assert quiet.getvalue() == ""
