@@ -75,7 +75,9 @@ enum pyins_index_scheme {
     PYINS_INDEX_TWO_POSITION = 2,     /* seed 002 traditional: stop, +180, stop, +180, stop, -180, stop, -180 */
     PYINS_INDEX_FOUR_POSITION = 3,    /* stops at 0, 180, 90, 270: +180, -90, +180, -270 (no slip ring) */
     PYINS_INDEX_FLEXIBLE_TWO = 4,     /* seed 002 flexible: flex-cos fwd, +180, flex-sin rev, -180 */
-    PYINS_INDEX_CUSTOM = 5            /* index_steps[0 .. index_n_steps-1] */
+    PYINS_INDEX_CUSTOM = 5,           /* index_steps[0 .. index_n_steps-1] */
+    PYINS_INDEX_FLEXIBLE_DERIVED = 6  /* seed 002's three-stop derivation: flex-cos fwd, flex-sin rev,
+                                         without the fixed 180-deg moves (SPEC 1.6 note 3) */
 };
 
 /* Move kinds of an indexing step. */

@@ -53,13 +53,14 @@ namespace {
 
 /// The indexing part of config_check, on a resolved configuration.
 int index_check(const pyins_config& cfg) {
-    if (cfg.index_scheme < PYINS_INDEX_NONE || cfg.index_scheme > PYINS_INDEX_CUSTOM) {
+    if (cfg.index_scheme < PYINS_INDEX_NONE || cfg.index_scheme > PYINS_INDEX_FLEXIBLE_DERIVED) {
         return PYINS_E_CONFIG_INDEX_SCHEME;
     }
     if (cfg.index_scheme == PYINS_INDEX_NONE) {
         return PYINS_OK;
     }
-    bool flexible = cfg.index_scheme == PYINS_INDEX_FLEXIBLE_TWO;
+    bool flexible = cfg.index_scheme == PYINS_INDEX_FLEXIBLE_TWO ||
+                    cfg.index_scheme == PYINS_INDEX_FLEXIBLE_DERIVED;
     if (cfg.index_scheme == PYINS_INDEX_CUSTOM) {
         if (cfg.index_n_steps < 1 || cfg.index_n_steps > indexing::kMaxSteps) {
             return PYINS_E_CONFIG_INDEX_EMPTY;

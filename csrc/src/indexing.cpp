@@ -106,6 +106,10 @@ int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps) {
             steps[2] = Step{stop_ticks, Kind::kFlexSin, -1.0};
             steps[3] = Step{stop_ticks, fx, -kPi};
             return 4;
+        case 6:  // seed 002's derivation (eqs. 9-13): conditional stops only
+            steps[0] = Step{stop_ticks, Kind::kFlexCos, 1.0};
+            steps[1] = Step{stop_ticks, Kind::kFlexSin, -1.0};
+            return 2;
         default:
             return -1;
     }

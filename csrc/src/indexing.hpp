@@ -76,7 +76,8 @@ struct Indexer {
 
 /// Preset schemes (enum pyins_index_scheme): 0 none, 1 single-position
 /// forward/reverse (seed 003), 2 traditional two-position (seed 002),
-/// 3 four-position, 4 flexible two-position (seed 002). Writes the cycle into
+/// 3 four-position, 4 flexible two-position (seed 002), 6 the flexible scheme
+/// of seed 002's derivation without the fixed 180-deg moves. Writes the cycle into
 /// steps (room for kMaxSteps) and returns its length, or -1 if unknown.
 int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps);
 

@@ -39,7 +39,7 @@ PYINS_E_CONFIG_INDEX_DELTA = -26
 PYINS_E_CONFIG_INDEX_STEP = -27
 
 INDEX_NONE, INDEX_SINGLE_FWD_REV, INDEX_TWO_POSITION, INDEX_FOUR_POSITION = 0, 1, 2, 3
-INDEX_FLEXIBLE_TWO, INDEX_CUSTOM = 4, 5
+INDEX_FLEXIBLE_TWO, INDEX_CUSTOM, INDEX_FLEXIBLE_DERIVED = 4, 5, 6
 
 FINE_FEEDBACK = 0      #: PYINS_FINE_FEEDBACK
 FINE_OPEN_LOOP = 1     #: PYINS_FINE_OPEN_LOOP
@@ -173,11 +173,11 @@ def config_resolved(cfg):
 def index_check(cfg):
     """The indexing part of config_check (mirrors index_check)."""
     scheme = cfg["index_scheme"]
-    if scheme < INDEX_NONE or scheme > INDEX_CUSTOM:
+    if scheme < INDEX_NONE or scheme > INDEX_FLEXIBLE_DERIVED:
         return PYINS_E_CONFIG_INDEX_SCHEME
     if scheme == INDEX_NONE:
         return PYINS_OK
-    flexible = scheme == INDEX_FLEXIBLE_TWO
+    flexible = scheme in (INDEX_FLEXIBLE_TWO, INDEX_FLEXIBLE_DERIVED)
     if scheme == INDEX_CUSTOM:
         n = cfg["index_n_steps"]
         if n < 1 or n > indexing.MAX_STEPS:

@@ -74,6 +74,7 @@ def preset_steps(scheme, stop_ticks):
         2: [(fx, pi), (fx, pi), (fx, -pi), (fx, -pi)],
         3: [(fx, pi), (fx, -0.5 * pi), (fx, pi), (fx, -1.5 * pi)],
         4: [(KIND_FLEX_COS, 1.0), (fx, pi), (KIND_FLEX_SIN, -1.0), (fx, -pi)],
+        6: [(KIND_FLEX_COS, 1.0), (KIND_FLEX_SIN, -1.0)],
     }
     if scheme not in table:
         return None

@@ -143,6 +143,8 @@ int main(void) {
     BAD_CFG((b.fine_ticks = 1000, b.fine_accel_vrw = NAN), PYINS_E_CONFIG_NOISE, "NaN accel VRW");
     BAD_CFG((b.fine_ticks = 1000, b.fine_sigma0_att_rad[2] = -1.0), PYINS_E_CONFIG_NOISE, "negative sigma0");
     BAD_CFG(b.index_scheme = 9, PYINS_E_CONFIG_INDEX_SCHEME, "unknown indexing scheme");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_FLEXIBLE_DERIVED, b.index_delta = -1.0), PYINS_E_CONFIG_INDEX_DELTA,
+            "derived flexible scheme with negative delta");
     BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 0), PYINS_E_CONFIG_INDEX_EMPTY,
             "empty custom scheme");
     BAD_CFG((b.index_scheme = PYINS_INDEX_CUSTOM, b.index_n_steps = 1, b.index_steps[0].stop_ticks = 100,

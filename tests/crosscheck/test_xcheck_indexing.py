@@ -21,7 +21,7 @@ RECORD = np.dtype([("state", "i4"), ("step", "i4"), ("fault", "i4"), ("fallbacks
 
 @st.composite
 def setups(draw):
-    scheme = draw(st.sampled_from([1, 2, 3, 4]))
+    scheme = draw(st.sampled_from([1, 2, 3, 4, 6]))
     stop = draw(st.integers(20, 400))
     steps = ix.preset_steps(scheme, stop)
     prm = ix.Params(steps=steps, rate=draw(st.sampled_from([6.0, 10.0, 30.0])) * DEG,
@@ -51,7 +51,7 @@ def c_run(prm, meas0, yaw_b):
 
 
 def test_presets_match():
-    for scheme in range(6):
+    for scheme in range(8):
         p = hooks.ffi.new("pyins_t_index_params *")
         n = hooks.lib.pyins_t_index_preset(scheme, 123, p)
         ref = ix.preset_steps(scheme, 123)
@@ -118,7 +118,8 @@ def test_scheme_rules(setup):
                 cond = (np.abs(np.sin(psi) + as_ / n_p) < prm.delta) & (np.cos(psi) * ac <= 0)
             first = np.flatnonzero(cond)
             rates = np.abs(rec["cmd_rate"][k:end])
-            if len(first) and first[0] < len(rates):
+            # (with a high acceleration the turn may end on the tick it is detected)
+            if len(first) and first[0] <= len(rates):
                 f0 = first[0]
                 assert np.all(np.diff(rates[f0:]) <= 1e-12)          # only braking after it
                 if f0 > 0:
