@@ -39,6 +39,21 @@ void enter_fault(Indexer& ix, Fault f) {
     ix.cmd_rate = 0.0;
 }
 
+/// Count the ticks the encoder is off the command; true (and FAULT) once
+/// that lasts longer than the timeout.
+bool off_command(Indexer& ix, double meas, Fault f) {
+    if (std::fabs(meas - ix.cmd_angle) > ix.prm.tolerance) {
+        ix.lag_ticks = ix.lag_ticks + 1;
+        if (ix.lag_ticks > ix.prm.timeout_ticks) {
+            enter_fault(ix, f);
+            return true;
+        }
+    } else {
+        ix.lag_ticks = 0;
+    }
+    return false;
+}
+
 /// The flexible stop condition of seed 002 on this tick's heading.
 bool flex_condition(const Indexer& ix, Kind kind, double yaw_p) {
     double s;
@@ -164,14 +179,8 @@ void update(Indexer& ix, double meas, double yaw_p) {
         ix.a_c = ix.a_c + c;
         ix.a_s = ix.a_s + s;
         ix.stop_count = ix.stop_count + 1;
-        if (std::fabs(meas - ix.cmd_angle) > ix.prm.tolerance) {
-            ix.lag_ticks = ix.lag_ticks + 1;
-            if (ix.lag_ticks > ix.prm.timeout_ticks) {
-                enter_fault(ix, Fault::kDrift);
-                return;
-            }
-        } else {
-            ix.lag_ticks = 0;
+        if (off_command(ix, meas, Fault::kDrift)) {
+            return;
         }
         if (ix.stop_count == ix.prm.steps[ix.step].stop_ticks) {
             start_move(ix);
@@ -192,14 +201,8 @@ void update(Indexer& ix, double meas, double yaw_p) {
         }
     }
     const bool arrived = advance_command(ix);
-    if (std::fabs(meas - ix.cmd_angle) > ix.prm.tolerance) {
-        ix.lag_ticks = ix.lag_ticks + 1;
-        if (ix.lag_ticks > ix.prm.timeout_ticks) {
-            enter_fault(ix, Fault::kLag);
-            return;
-        }
-    } else {
-        ix.lag_ticks = 0;
+    if (off_command(ix, meas, Fault::kLag)) {
+        return;
     }
     if (arrived && ix.target_known) {
         ix.step = (ix.step + 1) % ix.prm.n_steps;

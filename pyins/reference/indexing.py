@@ -123,6 +123,18 @@ def _enter_fault(ix, f):
     ix.cmd_rate = 0.0
 
 
+def _off_command(ix, meas, fault):
+    """Count ticks off the command; True (and FAULT) past the timeout."""
+    if abs(meas - ix.cmd_angle) > ix.prm.tolerance:
+        ix.lag_ticks = ix.lag_ticks + 1
+        if ix.lag_ticks > ix.prm.timeout_ticks:
+            _enter_fault(ix, fault)
+            return True
+    else:
+        ix.lag_ticks = 0
+    return False
+
+
 def _flex_condition(ix, kind, yaw_p):
     s = np.sin(yaw_p)
     c = np.cos(yaw_p)
@@ -181,13 +193,8 @@ def update(ix, meas, yaw_p):
         ix.a_c = ix.a_c + np.cos(yaw_p)
         ix.a_s = ix.a_s + np.sin(yaw_p)
         ix.stop_count = ix.stop_count + 1
-        if abs(meas - ix.cmd_angle) > ix.prm.tolerance:
-            ix.lag_ticks = ix.lag_ticks + 1
-            if ix.lag_ticks > ix.prm.timeout_ticks:
-                _enter_fault(ix, FAULT_DRIFT)
-                return
-        else:
-            ix.lag_ticks = 0
+        if _off_command(ix, meas, FAULT_DRIFT):
+            return
         if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
             _start_move(ix)
         return
@@ -201,13 +208,8 @@ def update(ix, meas, yaw_p):
             ix.target_known = True
             ix.fallbacks = ix.fallbacks + 1
     arrived = _advance_command(ix)
-    if abs(meas - ix.cmd_angle) > ix.prm.tolerance:
-        ix.lag_ticks = ix.lag_ticks + 1
-        if ix.lag_ticks > ix.prm.timeout_ticks:
-            _enter_fault(ix, FAULT_LAG)
-            return
-    else:
-        ix.lag_ticks = 0
+    if _off_command(ix, meas, FAULT_LAG):
+        return
     if arrived and ix.target_known:
         ix.step = (ix.step + 1) % ix.prm.n_steps
         _start_stop(ix)
