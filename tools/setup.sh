@@ -4,7 +4,8 @@
 #   bash tools/setup.sh            # install everything, then run the demo
 #   bash tools/setup.sh --no-demo  # install only
 #
-# Installs the system packages (Eigen, compilers, CMake, Ninja, valgrind),
+# Installs the system packages (Eigen, compilers, CMake, Ninja, valgrind, the
+# ARM bare-metal toolchain and QEMU for the Cortex-M builds),
 # makes a virtual environment in .venv and installs pyins into it (editable:
 # Python edits take effect at once; after C++ edits run this script again,
 # the C++ build is incremental under build/).
@@ -16,7 +17,8 @@ if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -qq
 $sudo apt-get install -y -qq --no-install-recommends \
-    libeigen3-dev g++ cmake ninja-build python3 python3-venv valgrind >/dev/null
+    libeigen3-dev g++ cmake ninja-build python3 python3-venv valgrind \
+    gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi qemu-system-arm >/dev/null
 
 python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip

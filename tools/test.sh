@@ -10,6 +10,14 @@ cmake -S . -B build/host -G Ninja -DCMAKE_BUILD_TYPE=Release -DPYINS_BUILD_TESTS
 cmake --build build/host
 ctest --test-dir build/host --output-on-failure
 
+# The same core on Cortex-M7 and M4F under QEMU, bit-identical to the host
+# and to Python (skipped with a notice when the ARM toolchain is missing).
+if command -v arm-none-eabi-gcc >/dev/null && command -v qemu-system-arm >/dev/null; then
+    bash tools/embedded.sh
+else
+    echo "NOTICE: arm-none-eabi-gcc or qemu-system-arm missing: embedded builds not tested" >&2
+fi
+
 # Plain `pytest` (not `python -m pytest`): the repo root must not shadow the
 # installed package, whose directory holds the built library.
 set +e

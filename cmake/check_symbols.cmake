@@ -1,0 +1,35 @@
+# check_symbols.cmake: the undefined symbols of the core library against an
+# allow-list: correctly rounded or exact libm functions, memory primitives,
+# and (M4F) libgcc's soft-double helpers. Any malloc, operator new, __cxa_*
+# or transcendental libm call fails the test.
+#   cmake -DNM=arm-none-eabi-nm -DLIB=libpyins_core.a -P check_symbols.cmake
+execute_process(COMMAND ${NM} -u ${LIB} OUTPUT_VARIABLE out RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} failed on ${LIB}")
+endif()
+string(REGEX MATCHALL "[ \t]U[ \t]+[^\n]+" lines "${out}")
+set(bad "")
+set(seen "")
+foreach(line ${lines})
+  string(REGEX REPLACE "^[ \t]U[ \t]+" "" sym "${line}")
+  string(STRIP "${sym}" sym)
+  list(APPEND seen ${sym})
+  if(NOT sym MATCHES "^(sqrt|floor|fmod|memset|memcpy|memmove|__aeabi_[a-z0-9]+)$")
+    list(APPEND bad ${sym})
+  endif()
+endforeach()
+list(REMOVE_DUPLICATES seen)
+# symbols defined inside the library itself also show as U in other members
+execute_process(COMMAND ${NM} --defined-only ${LIB} OUTPUT_VARIABLE defined)
+set(really_bad "")
+foreach(sym ${bad})
+  if(NOT defined MATCHES "[ \t][TtDdBbRrWw][ \t]+${sym}\n")
+    list(APPEND really_bad ${sym})
+  endif()
+endforeach()
+list(REMOVE_DUPLICATES really_bad)
+message("undefined symbols of the core: ${seen}")
+if(really_bad)
+  message(FATAL_ERROR "symbols outside the allow-list: ${really_bad}")
+endif()
+message("core symbols OK")

@@ -1,0 +1,42 @@
+/* demo_scenario.c: see demo_scenario.h. Only + - * / on exactly
+ * representable values: no libm, so every target computes the same bits. */
+#include "demo_scenario.h"
+
+#include <string.h>
+
+/* Increments of a level IMU at yaw 0 at 34.246 N, to double precision
+ * (static: dtheta = C_n^b omega_ie^n dt, dv = C_n^b [0 0 g] dt). The
+ * decimal constants are exact inputs; what matters is that every platform
+ * parses them to the same double, which IEEE guarantees. */
+static const double kDthetaN = 6.027874130954723e-07;  /* W cos L dt [rad] */
+static const double kDthetaU = 4.103617522881293e-07;  /* W sin L dt [rad] */
+static const double kDvU = 0.09796698857772466;        /* g dt [m/s] */
+
+void demo_config(pyins_config *cfg) {
+    memset(cfg, 0, sizeof *cfg);
+    cfg->lat_rad = 0.5977054556379782;      /* 34.246 deg */
+    cfg->lon_rad = 1.9008380883470242;       /* 108.910 deg */
+    cfg->coarse_ticks = 6000;
+    cfg->fine_ticks = 6000;
+    cfg->fine_states = 5;
+    cfg->index_scheme = PYINS_INDEX_TWO_POSITION;
+    cfg->index_stop_ticks = 2000;
+}
+
+static double lcg_unit(uint64_t *state) {
+    /* Knuth's MMIX LCG; the top 21 bits as an integer in [-2^20, 2^20) */
+    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)((int64_t)(*state >> 43) - (int64_t)(1 << 20));
+}
+
+void demo_sample(uint64_t *state, double encoder_rad, pyins_sample *s) {
+    const double k_ang = 1.0 / 1099511627776.0 / 1048576.0;  /* 2^-60 rad per LCG unit */
+    const double k_vel = 1.0 / 1073741824.0 / 1048576.0;     /* 2^-50 m/s per LCG unit */
+    s->dtheta_p_rad[0] = lcg_unit(state) * k_ang;
+    s->dtheta_p_rad[1] = kDthetaN + lcg_unit(state) * k_ang;
+    s->dtheta_p_rad[2] = kDthetaU + lcg_unit(state) * k_ang;
+    s->dv_p_mps[0] = lcg_unit(state) * k_vel;
+    s->dv_p_mps[1] = lcg_unit(state) * k_vel;
+    s->dv_p_mps[2] = kDvU + lcg_unit(state) * k_vel;
+    s->table_angle_rad = encoder_rad;
+}

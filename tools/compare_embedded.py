@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Bit-identity of the firmware across builds: host, Python (cffi), Cortex-M7
+and Cortex-M4F under QEMU, on the demo scenario of csrc/embedded.
+
+    .venv/bin/python tools/compare_embedded.py [--host build/host/demo_host]
+        [--m7 build-m7/demo.elf] [--m4 build-m4/demo.elf] [--json runs/bench/embedded.json]
+
+Every build prints the same lines (tick, mode, index state and eleven
+doubles as hex every 500 ticks). The Python run replays the scenario's
+integer-only sample generator through the installed package. Any difference
+is a failure naming the first differing tick and field; exit status 1.
+"""
+import argparse
+import json
+import os
+import struct
+import subprocess
+import sys
+
+import numpy as np
+
+from pyins import native
+
+FIELDS = ["lat_rad", "lon_rad", "vel_E", "vel_N", "quat_nb_w", "quat_nb_x", "quat_nb_y", "quat_nb_z",
+          "kf_x_2", "table_angle_cmd_rad", "index_a_c"]
+TWO_PI = 6.283185307179586
+
+
+def python_lines():
+    """The demo of csrc/embedded/demo_main.c through pyins.native."""
+    ffi, lib = native.ffi, native.lib
+    cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
+               fine_states=5, index_scheme=2, index_stop_ticks=2000)
+    fw = native.Firmware(cfg)
+    lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
+    state = 1
+    mask = (1 << 64) - 1
+    k_ang = 1.0 / 1099511627776.0 / 1048576.0
+    k_vel = 1.0 / 1073741824.0 / 1048576.0
+
+    def unit():
+        nonlocal state
+        state = (state * 6364136223846793005 + 1442695040888963407) & mask
+        return float((state >> 43) - (1 << 20))
+
+    enc = 0.0
+    sample = ffi.new("pyins_sample *")
+    out = ffi.new("pyins_output *")
+    for k in range(24000):
+        sample.dtheta_p_rad[0] = unit() * k_ang
+        sample.dtheta_p_rad[1] = 6.027874130954723e-07 + unit() * k_ang
+        sample.dtheta_p_rad[2] = 4.103617522881293e-07 + unit() * k_ang
+        sample.dv_p_mps[0] = unit() * k_vel
+        sample.dv_p_mps[1] = unit() * k_vel
+        sample.dv_p_mps[2] = 0.09796698857772466 + unit() * k_vel
+        sample.table_angle_rad = enc
+        st = lib.pyins_step(fw.core, sample, out)
+        if st != 0:
+            raise RuntimeError(f"step {k}: {native.status_str(st)}")
+        enc = out.table_angle_cmd_rad
+        while enc >= TWO_PI:
+            enc -= TWO_PI
+        while enc < 0.0:
+            enc += TWO_PI
+        if (k + 1) % 500 == 0:
+            vals = [out.lat_rad, out.lon_rad, out.vel_n_mps[0], out.vel_n_mps[1], *list(out.quat_nb),
+                    out.kf_x[2], out.table_angle_cmd_rad, out.index_a_c]
+            hexes = " ".join(struct.pack(">d", v).hex() for v in vals)
+            lines.append(f"{k + 1} {out.mode} {out.index_state} {hexes}")
+    lines.append("DONE")
+    return lines
+
+
+def run_lines(cmd):
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    return res.stdout.strip().splitlines(), res.returncode
+
+
+def first_difference(a, b):
+    for la, lb in zip(a, b):
+        if la != lb:
+            ta, tb = la.split(), lb.split()
+            if len(ta) < 3 or len(tb) < 3 or ta[:1] != tb[:1]:
+                return f"line '{la}' vs '{lb}'"
+            for i, (x, y) in enumerate(zip(ta[3:], tb[3:])):
+                if x != y:
+                    va = struct.unpack(">d", bytes.fromhex(x))[0]
+                    vb = struct.unpack(">d", bytes.fromhex(y))[0]
+                    return f"tick {ta[0]}, field {FIELDS[i]}: {x} ({va!r}) vs {y} ({vb!r})"
+            return f"tick {ta[0]}: mode/state {ta[1:3]} vs {tb[1:3]}"
+    if len(a) != len(b):
+        return f"{len(a)} lines vs {len(b)} lines"
+    return None
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--host", default=os.path.join("build", "host", "demo_host"))
+    ap.add_argument("--m7", default=os.path.join("build-m7", "demo.elf"))
+    ap.add_argument("--m4", default=os.path.join("build-m4", "demo.elf"))
+    ap.add_argument("--json", default=os.path.join("runs", "bench", "embedded_identity.json"))
+    args = ap.parse_args(argv)
+    runs = {"python": (python_lines(), 0)}
+    if os.path.exists(args.host):
+        runs["host"] = run_lines([args.host])
+    for name, elf, board in (("cortex-m7", args.m7, "mps2-an500"), ("cortex-m4f", args.m4, "mps2-an386")):
+        if os.path.exists(elf):
+            runs[name] = run_lines(["qemu-system-arm", "-M", board, "-nographic", "-semihosting", "-kernel", elf])
+    ref_name = "host" if "host" in runs else "python"
+    ref = runs[ref_name][0]
+    ok = True
+    result = {"reference": ref_name, "lines": len(ref)}
+    for name, (lines, rc) in runs.items():
+        diff = first_difference(ref, lines)
+        same = diff is None and rc == 0
+        ok = ok and same
+        result[f"{name}_identical"] = same
+        print(f"{name:11s} {'bit-identical to ' + ref_name if same else 'DIFFERS: ' + str(diff or f'exit {rc}')}")
+    os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
+    with open(args.json, "w") as f:
+        json.dump(result, f, indent=2)
+    if len(runs) < 4:
+        print(f"(only {', '.join(runs)} compared: build the missing targets with tools/embedded.sh)")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
