@@ -19,7 +19,7 @@ import numpy as np
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 5)
+EXPECTED_ABI = (0, 6)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")
@@ -143,6 +143,10 @@ class SampleError(CoreError, ValueError):
                                f"accepted; the state is after them)")
 
 
+class SnapshotError(CoreError, ValueError):
+    """The core refused a snapshot blob; the state was left as it was."""
+
+
 def status_str(code):
     return ffi.string(lib.pyins_status_str(int(code))).decode()
 
@@ -262,16 +266,19 @@ class Firmware:
 
     def __init__(self, config=None, **fields):
         cfg = make_config(config, **fields)
+        self._setup_memory()
+        status = lib.pyins_init(self._core, lib.pyins_core_size(), cfg)
+        if status != 0:
+            raise ConfigError(status, "pyins_init")
+        self.config = {name: getattr(cfg, name) for name in CONFIG_FIELDS
+                       if not isinstance(getattr(cfg, name), ffi.CData)}
+
+    def _setup_memory(self):
         size = lib.pyins_core_size()
         align = lib.pyins_core_align()
         self._mem = ffi.new("unsigned char[]", size + align)
         addr = int(ffi.cast("uintptr_t", self._mem))
         self._core = ffi.cast("pyins_core *", self._mem + (-addr) % align)
-        status = lib.pyins_init(self._core, size, cfg)
-        if status != 0:
-            raise ConfigError(status, "pyins_init")
-        self.config = {name: getattr(cfg, name) for name in CONFIG_FIELDS
-                       if not isinstance(getattr(cfg, name), ffi.CData)}
         self._one_out = np.zeros(1, dtype=OUTPUT_DTYPE)
         self._one_out_ptr = ffi.cast("pyins_output *", ffi.from_buffer(self._one_out))
         self._one_sample = np.zeros(1, dtype=SAMPLE_DTYPE)
@@ -295,6 +302,34 @@ class Firmware:
                 raise SampleError(status, int(n_done[0]), outputs[: n_out[0]].copy())
             raise CoreError(status, "pyins_run_decimated")
         return outputs[: n_out[0]]
+
+    def snapshot(self):
+        """The whole firmware state as a versioned, checksummed blob (bytes)."""
+        buf = ffi.new("unsigned char[]", lib.pyins_snapshot_size())
+        status = lib.pyins_snapshot(self._core, buf, len(buf))
+        if status != 0:
+            raise CoreError(status, "pyins_snapshot")
+        return bytes(ffi.buffer(buf))
+
+    def restore(self, blob):
+        """Replace the state with a snapshot. A truncated, corrupted,
+        wrong-version or wrong-size blob raises SnapshotError and leaves the
+        current state untouched."""
+        if not isinstance(blob, (bytes, bytearray, memoryview)):
+            raise ValueError(f"snapshot: expected bytes, got {type(blob).__name__}")
+        data = ffi.from_buffer(bytes(blob))
+        status = lib.pyins_restore(self._core, lib.pyins_core_size(), data, len(data))
+        if status != 0:
+            raise SnapshotError(status, "pyins_restore")
+
+    @classmethod
+    def from_snapshot(cls, blob):
+        """A new instance holding a snapshot's state."""
+        fw = cls.__new__(cls)
+        fw._setup_memory()
+        fw.config = {}
+        fw.restore(blob)
+        return fw
 
     def index_reset(self):
         """Leave the indexing FAULT state (pyins_index_reset)."""

@@ -26,7 +26,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 5
+#define PYINS_ABI_VERSION_MINOR 6
 
 #ifdef __cplusplus
 extern "C" {
@@ -65,7 +65,10 @@ enum pyins_status {
     PYINS_E_CONFIG_INDEX_EMPTY = -24, /* custom scheme with no steps (or more than 8) */
     PYINS_E_CONFIG_INDEX_RATE = -25,  /* indexing rate or acceleration not positive (custom) or negative */
     PYINS_E_CONFIG_INDEX_DELTA = -26, /* flexible threshold delta not positive (custom) or negative */
-    PYINS_E_CONFIG_INDEX_STEP = -27   /* a custom step, stop length, tolerance or timeout out of range */
+    PYINS_E_CONFIG_INDEX_STEP = -27,  /* a custom step, stop length, tolerance or timeout out of range */
+    PYINS_E_SNAPSHOT_SIZE = -28,      /* snapshot blob truncated, too long, or its buffer too small */
+    PYINS_E_SNAPSHOT_VERSION = -29,   /* snapshot of another format or ABI version */
+    PYINS_E_SNAPSHOT_CORRUPT = -30    /* snapshot magic or checksum wrong */
 };
 
 /* Indexing schemes (pyins_config.index_scheme). */
@@ -274,6 +277,21 @@ int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
  * from the measured table angle (A_c, A_s kept). Does nothing otherwise.
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_index_reset(pyins_core *core);
+
+/* Bytes of a snapshot blob: a 24-byte header (magic "PYSN", format version,
+ * ABI version, payload size, CRC-32 of the payload, reserved) and the whole
+ * firmware state. */
+size_t pyins_snapshot_size(void);
+
+/* Write the whole state of core into buf (buf_size >= pyins_snapshot_size()).
+ * Restoring it and stepping on gives output bit-identical to never stopping.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_snapshot(const pyins_core *core, void *buf, size_t buf_size);
+
+/* Build an instance in mem from a snapshot blob (like pyins_init). A
+ * truncated, corrupted, wrong-version or wrong-size blob is refused and mem
+ * is left as it was. Returns PYINS_OK or a negative pyins_status. */
+int pyins_restore(void *mem, size_t mem_size, const void *buf, size_t buf_size);
 
 /* Write the current state as an output record (no step).
  * Returns PYINS_OK or a negative pyins_status. */

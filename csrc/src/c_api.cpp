@@ -7,6 +7,7 @@
 #include "pyins_core.h"
 
 #include <cstdint>
+#include <cstring>
 #include <new>
 
 #include "firmware.hpp"
@@ -36,6 +37,34 @@ int checked(const pyins_core* core, const Firmware** fw) {
     }
     *fw = f;
     return PYINS_OK;
+}
+
+constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
+constexpr uint32_t kSnapFormat = 1u;
+constexpr size_t kSnapHeader = 24u;
+
+/// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
+uint32_t crc32(const unsigned char* p, size_t n) {
+    uint32_t c = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; ++i) {
+        c = c ^ p[i];
+        for (int k = 0; k < 8; ++k) {
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+        }
+    }
+    return ~c;
+}
+
+void put_u32(unsigned char* p, uint32_t v) {
+    p[0] = static_cast<unsigned char>(v);
+    p[1] = static_cast<unsigned char>(v >> 8);
+    p[2] = static_cast<unsigned char>(v >> 16);
+    p[3] = static_cast<unsigned char>(v >> 24);
+}
+
+uint32_t get_u32(const unsigned char* p) {
+    return static_cast<uint32_t>(p[0]) | (static_cast<uint32_t>(p[1]) << 8) |
+           (static_cast<uint32_t>(p[2]) << 16) | (static_cast<uint32_t>(p[3]) << 24);
 }
 
 }  // namespace
@@ -182,6 +211,68 @@ int pyins_index_reset(pyins_core* core) {
     return PYINS_OK;
 }
 
+size_t pyins_snapshot_size(void) { return kSnapHeader + sizeof(Firmware); }
+
+int pyins_snapshot(const pyins_core* core, void* buf, size_t buf_size) {
+    const Firmware* fw = nullptr;
+    const int status = checked(core, &fw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (buf == nullptr) {
+        return PYINS_E_NULL;
+    }
+    if (buf_size < pyins_snapshot_size()) {
+        return PYINS_E_SNAPSHOT_SIZE;
+    }
+    unsigned char* b = static_cast<unsigned char*>(buf);
+    const unsigned char* payload = reinterpret_cast<const unsigned char*>(fw);
+    memcpy(b + kSnapHeader, payload, sizeof(Firmware));
+    put_u32(b, kSnapMagic);
+    put_u32(b + 4, kSnapFormat);
+    put_u32(b + 8, pyins_abi_version());
+    put_u32(b + 12, static_cast<uint32_t>(sizeof(Firmware)));
+    put_u32(b + 16, crc32(b + kSnapHeader, sizeof(Firmware)));
+    put_u32(b + 20, 0u);
+    return PYINS_OK;
+}
+
+int pyins_restore(void* mem, size_t mem_size, const void* buf, size_t buf_size) {
+    if (mem == nullptr || buf == nullptr) {
+        return PYINS_E_NULL;
+    }
+    if (!is_aligned(mem, alignof(Firmware))) {
+        return PYINS_E_MISALIGNED;
+    }
+    if (mem_size < sizeof(Firmware)) {
+        return PYINS_E_MEM_TOO_SMALL;
+    }
+    if (buf_size < kSnapHeader) {
+        return PYINS_E_SNAPSHOT_SIZE;
+    }
+    const unsigned char* b = static_cast<const unsigned char*>(buf);
+    if (get_u32(b) != kSnapMagic) {
+        return PYINS_E_SNAPSHOT_CORRUPT;
+    }
+    if (get_u32(b + 4) != kSnapFormat || get_u32(b + 8) != pyins_abi_version()) {
+        return PYINS_E_SNAPSHOT_VERSION;
+    }
+    if (get_u32(b + 12) != sizeof(Firmware) || buf_size != pyins_snapshot_size()) {
+        return PYINS_E_SNAPSHOT_SIZE;
+    }
+    if (get_u32(b + 16) != crc32(b + kSnapHeader, sizeof(Firmware))) {
+        return PYINS_E_SNAPSHOT_CORRUPT;
+    }
+    uint32_t magic;  // the instance's own marker, first member of Firmware
+    memcpy(&magic, b + kSnapHeader + Firmware::magic_offset(), sizeof magic);
+    if (magic != pyins::firmware::kMagic) {
+        return PYINS_E_SNAPSHOT_CORRUPT;
+    }
+    // the payload holds no pointers (fixed-size values only): a byte copy is the state
+    memcpy(mem, b + kSnapHeader, sizeof(Firmware));
+    return PYINS_OK;
+}
+
 int pyins_get_output(const pyins_core* core, pyins_output* out) {
     const Firmware* fw = nullptr;
     const int status = checked(core, &fw);
@@ -222,6 +313,9 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_INDEX_RATE: return "PYINS_E_CONFIG_INDEX_RATE: indexing rate and acceleration must be positive and finite";
         case PYINS_E_CONFIG_INDEX_DELTA: return "PYINS_E_CONFIG_INDEX_DELTA: the flexible threshold delta must be in (0, 1)";
         case PYINS_E_CONFIG_INDEX_STEP: return "PYINS_E_CONFIG_INDEX_STEP: an indexing step (stop ticks >= 1, known kind, non-zero finite angle), tolerance, jump or timeout out of range";
+        case PYINS_E_SNAPSHOT_SIZE: return "PYINS_E_SNAPSHOT_SIZE: snapshot blob truncated or of the wrong length, or buffer too small";
+        case PYINS_E_SNAPSHOT_VERSION: return "PYINS_E_SNAPSHOT_VERSION: snapshot of another format or ABI version";
+        case PYINS_E_SNAPSHOT_CORRUPT: return "PYINS_E_SNAPSHOT_CORRUPT: snapshot magic or checksum wrong";
         case PYINS_E_CONFIG_ALIGN_TICKS: return "PYINS_E_CONFIG_ALIGN_TICKS: an alignment duration is negative, or the first output comes after its end";
         default: return "unknown pyins status code";
     }

@@ -5,6 +5,7 @@
 // and indexing extend the same instance.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "pyins_core.h"
@@ -76,6 +77,8 @@ class Firmware {
     void index_reset();
 
     uint32_t magic() const { return magic_; }
+    /// Byte offset of the marker inside the instance (for snapshots).
+    static constexpr size_t magic_offset() { return 0; }
     int64_t tick() const { return tick_; }
 
   private:

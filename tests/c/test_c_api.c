@@ -73,7 +73,8 @@ int main(void) {
                              PYINS_E_CONFIG_FINE, PYINS_E_CONFIG_NOISE,
                              PYINS_E_CONFIG_INDEX_SCHEME, PYINS_E_CONFIG_INDEX_EMPTY,
                              PYINS_E_CONFIG_INDEX_RATE, PYINS_E_CONFIG_INDEX_DELTA,
-                             PYINS_E_CONFIG_INDEX_STEP};
+                             PYINS_E_CONFIG_INDEX_STEP, PYINS_E_SNAPSHOT_SIZE,
+                             PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
         int distinct = 1;
@@ -252,6 +253,40 @@ int main(void) {
         }
         check(i == N, "step B all accepted");
         check(memcmp(a, b, sizeof a) == 0, "N single steps == one N-sample run, bit for bit");
+
+        /* Snapshot at 400, restore into fresh memory, continue: same bits. */
+        {
+            const size_t snap = pyins_snapshot_size();
+            unsigned char *blob = (unsigned char *)malloc(snap);
+            unsigned char *raw3 = NULL;
+            unsigned char *mem3 = aligned_mem(size, &raw3);
+            static pyins_output c[N];
+            pyins_output before3, after3;
+            check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "init D");
+            check_status(pyins_run((pyins_core *)mem2, samples, 400, c, NULL), PYINS_OK, "run to 400");
+            check_status(pyins_snapshot((pyins_core *)mem2, blob, snap - 1), PYINS_E_SNAPSHOT_SIZE, "snapshot buffer too small");
+            check_status(pyins_snapshot((pyins_core *)mem2, blob, snap), PYINS_OK, "snapshot");
+            memset(mem3, 0, size);
+            check_status(pyins_restore(mem3, size, blob, snap), PYINS_OK, "restore");
+            check_status(pyins_run((pyins_core *)mem3, samples + 400, N - 400, c + 400, NULL), PYINS_OK, "run on");
+            check(memcmp(c + 400, a + 400, (N - 400) * sizeof c[0]) == 0, "restored run == uninterrupted, bit for bit");
+            pyins_get_output((pyins_core *)mem3, &before3);
+            check_status(pyins_restore(mem3, size, blob, snap - 1), PYINS_E_SNAPSHOT_SIZE, "truncated snapshot");
+            blob[8] ^= 0x01u;   /* ABI version field */
+            check_status(pyins_restore(mem3, size, blob, snap), PYINS_E_SNAPSHOT_VERSION, "wrong-version snapshot");
+            blob[8] ^= 0x01u;
+            blob[100] ^= 0x40u; /* a payload byte */
+            check_status(pyins_restore(mem3, size, blob, snap), PYINS_E_SNAPSHOT_CORRUPT, "corrupted snapshot");
+            blob[100] ^= 0x40u;
+            blob[0] = 'X';
+            check_status(pyins_restore(mem3, size, blob, snap), PYINS_E_SNAPSHOT_CORRUPT, "bad magic");
+            pyins_get_output((pyins_core *)mem3, &after3);
+            check(memcmp(&before3, &after3, sizeof before3) == 0, "refused snapshots leave the state untouched");
+            check_status(pyins_restore(mem3 + 1, size, blob, snap), PYINS_E_MISALIGNED, "restore misaligned");
+            check_status(pyins_restore(mem3, size - 1, blob, snap), PYINS_E_MEM_TOO_SMALL, "restore too small");
+            free(raw3);
+            free(blob);
+        }
 
         /* Decimated runs: records at ticks that are multiples of out_every,
          * equal to the full run's records, whatever the chunking. */
