@@ -40,7 +40,7 @@ typedef struct pyins_t_strapdown {
 typedef struct pyins_t_fine_params {
     double sin_lat, cos_lat, gravity, dt;
     int32_t meas_every;
-    int32_t feedback;
+    int32_t reserved;
     double gyro_arw, accel_vrw;
     double sigma0_att[3];
     double sigma0_gyro, sigma0_accel;

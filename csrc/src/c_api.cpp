@@ -509,7 +509,6 @@ int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params* p, const d
     prm.sigma0_att[2] = p->sigma0_att[2];
     prm.sigma0_gyro = p->sigma0_gyro;
     prm.sigma0_accel = p->sigma0_accel;
-    prm.feedback = p->feedback != 0;
     if (states == 5) {
         fine_run<5>(prm, dv_sf_n, n, x_out, p_out);
     } else if (states == 8) {

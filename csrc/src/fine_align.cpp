@@ -73,7 +73,6 @@ void init(FineAlign<N>& f, const Params& prm) {
     f.meas_count = 0;
     f.meas_every = prm.meas_every;
     f.meas_span = static_cast<double>(prm.meas_every) * prm.dt;
-    f.feedback = prm.feedback;
     f.healthy = true;
 }
 

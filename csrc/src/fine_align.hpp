@@ -19,9 +19,10 @@
 // (seed 001 prints R as a copy of Q: a typo; the accelerometer noise
 // projected into n is meant). P0 = diag(sigma0)^2 with seed 001's
 // sigma0 = 10 x [10', 10', 60', 0.001 deg/h, 0.001 deg/h] by default.
-// Feedback (recommended by the paper): after each update the attitude is
-// corrected by phi^ and phi^ reset to zero; open loop leaves the attitude
-// alone and reports the corrected one.
+// Feedback (recommended by the paper; the firmware's choice, not this
+// module's): after each update the attitude is corrected by phi^ and phi^
+// reset to zero (reset_phi); open loop leaves the attitude alone and reports
+// the corrected one.
 #pragma once
 
 #include <cstdint>
@@ -42,7 +43,6 @@ struct Params {
     double sigma0_att[3];    ///< [rad] E, N, U
     double sigma0_gyro;      ///< [rad/s]
     double sigma0_accel;     ///< [m/s^2] (8-state only)
-    bool feedback;
 };
 
 template <int N>
@@ -58,7 +58,6 @@ struct FineAlign {
     int32_t meas_count;      ///< ticks in dv_sum
     int32_t meas_every;
     double meas_span;        ///< meas_every * dt [s]
-    bool feedback;
     bool healthy;            ///< P positive definite (diagonal check) after every step
 };
 

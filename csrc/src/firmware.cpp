@@ -344,7 +344,6 @@ void Firmware::start_fine() {
     prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
     prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
-    prm.feedback = cfg_.fine_correction == PYINS_FINE_FEEDBACK;
     kf_states_ = cfg_.fine_states;
     fine_tick_ = 0;
     if (kf_states_ == 8) {

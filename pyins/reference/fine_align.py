@@ -22,7 +22,6 @@ class Params:
     sigma0_att: np.ndarray
     sigma0_gyro: float
     sigma0_accel: float
-    feedback: bool
 
 
 @dataclass
@@ -38,7 +37,6 @@ class FineAlign:
     meas_count: int
     meas_every: int
     meas_span: float
-    feedback: bool
     healthy: bool
 
 
@@ -84,7 +82,7 @@ def init(n, prm):
     p = np.diag(sigma * sigma)
     return FineAlign(n=n, x=np.zeros(n), p=p, phi=phi, qd=qd, h=h, r=r, dv_sum=np.zeros(3),
                      meas_count=0, meas_every=prm.meas_every,
-                     meas_span=float(prm.meas_every) * prm.dt, feedback=prm.feedback, healthy=True)
+                     meas_span=float(prm.meas_every) * prm.dt, healthy=True)
 
 
 def step(f, dv_sf_n):

@@ -350,8 +350,7 @@ class Firmware:
             sin_lat=sin_lat, cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
             dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
             accel_vrw=cfg["fine_accel_vrw"], sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
-            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
-            feedback=cfg["fine_correction"] == FINE_FEEDBACK)
+            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
         self.kf_states = cfg["fine_states"]
         self.fine_tick = 0
         self.fine = fine_align.init(self.kf_states, prm)

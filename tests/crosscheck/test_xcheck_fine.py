@@ -73,13 +73,13 @@ def test_fine_filter_module_state_and_full_covariance(states, lat, meas_every, n
     rng = np.random.default_rng(seed)
     dv = np.tile([-g * tilt[1], g * tilt[0], g], (n, 1)) * 0.01 + vrw * 0.1 * rng.standard_normal((n, 3))
     prm = fine_align.Params(np.sin(lat), np.cos(lat), g, 0.01, meas_every, arw, vrw,
-                            np.array([3e-3, 3e-3, 2e-2]), 5e-8, 1e-3, True)
+                            np.array([3e-3, 3e-3, 2e-2]), 5e-8, 1e-3)
     f = fine_align.init(states, prm)
     for k in range(n):
         fine_align.step(f, dv[k])
     cp = hooks.ffi.new("pyins_t_fine_params *")
     cp.sin_lat, cp.cos_lat, cp.gravity, cp.dt = prm.sin_lat, prm.cos_lat, g, 0.01
-    cp.meas_every, cp.feedback, cp.gyro_arw, cp.accel_vrw = meas_every, 1, arw, vrw
+    cp.meas_every, cp.gyro_arw, cp.accel_vrw = meas_every, arw, vrw
     for i in range(3):
         cp.sigma0_att[i] = prm.sigma0_att[i]
     cp.sigma0_gyro, cp.sigma0_accel = prm.sigma0_gyro, prm.sigma0_accel
