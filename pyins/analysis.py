@@ -151,3 +151,43 @@ def static_error_model(lat, times_s, eps_n, nabla_n=None, height=0.0, step_s=0.5
     east = out[:, 6] * rn_h * cos_lat
     return StaticErrors(time_s=times_s, att_n_rad=out[:, :3], vel_n_mps=out[:, 3:5], north_m=north,
                         east_m=east, horizontal_m=np.hypot(north, east))
+
+
+def table_projected(bias_p, euler_b, rec_time_s, rec_alpha_rad, alpha0=0.0):
+    """The IMU-frame constant ``bias_p`` (3,) seen in n on a static ship at
+    ``euler_b`` whose table turned as recorded (times [s], angles [rad],
+    unwrapped; ``alpha0`` at t = 0): a function of time for
+    ``static_error_model``.
+
+    C_p^n(t) = C_b^n Rz(alpha(t)) (DESIGN.md sec. 2); alpha is interpolated
+    linearly between records, exact while the table turns at constant rate
+    or stands still.
+    """
+    mat_nb = attitude.euler_to_mat(np.asarray(euler_b, dtype=float))
+    b = np.asarray(bias_p, dtype=float)
+    t_rec = np.concatenate([[0.0], np.asarray(rec_time_s, dtype=float)])
+    a_rec = np.concatenate([[alpha0], np.asarray(rec_alpha_rad, dtype=float)])
+
+    def in_n(t):
+        alpha = np.interp(t, t_rec, a_rec)
+        c, s = np.cos(alpha), np.sin(alpha)
+        in_b = np.column_stack([c * b[0] - s * b[1], s * b[0] + c * b[1], np.full_like(t, b[2])])
+        return in_b @ mat_nb.T
+    return in_n
+
+
+def predict_static_fil(result, lat, euler_b, gyro_bias_p, accel_bias_p, times_s, alpha0=0.0,
+                       step_s=0.5):
+    """What the linear error model says a static FIL run should show.
+
+    ``result`` is a ``pyins.fil.FilResult`` (its plant records give the table
+    angle); the constant gyro drifts and accelerometer biases of the IMU
+    frame are projected through the table angle and propagated by
+    ``static_error_model``. Scale-factor, installation and random errors are
+    left out: for a static ship they are second order.
+    """
+    t_rec = result.plant["tick"] * result.dt
+    alpha = result.plant["alpha_rad"]
+    return static_error_model(lat, times_s, table_projected(gyro_bias_p, euler_b, t_rec, alpha, alpha0),
+                              table_projected(accel_bias_p, euler_b, t_rec, alpha, alpha0),
+                              step_s=step_s)

@@ -22,12 +22,22 @@ import sys
 
 import numpy as np
 
-from pyins import fil, runner, sim
+from pyins import analysis, fil, runner, sim
 from pyins.reference import earth
 
 DEG = earth.DEG_TO_RAD
 ARCMIN = earth.ARCMIN_TO_RAD
 PAPER = {"position_nmi": 1.1, "level_arcmin": 0.01, "heading_arcmin": 0.3, "velocity_mps": 0.06}
+
+
+def figures(err):
+    """The paper's four maxima from a NavErrors or StaticErrors."""
+    return {
+        "position_nmi": err.horizontal_m.max() / earth.NMI_TO_M,
+        "level_arcmin": np.abs(err.att_n_rad[:, :2]).max() / ARCMIN,
+        "heading_arcmin": np.abs(err.att_n_rad[:, 2]).max() / ARCMIN,
+        "velocity_mps": np.abs(err.vel_n_mps[:, :2]).max(),
+    }
 
 
 def main(argv=None):
@@ -41,51 +51,116 @@ def main(argv=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    m = sim.Static(34.246 * DEG, 108.91 * DEG, 0.0)
+    lat = 34.246 * DEG
+    m = sim.Static(lat, 108.91 * DEG, 0.0)
     errors = sim.preset("seed003")
     ticks = int(args.hours * 360_000)
+    grid = np.arange(1, int(args.hours * 12) + 1) * 300.0       # the linear model every 5 min
     fig_json = {"hours": args.hours, "latitude_deg": 34.246}
     rows = []
     fg, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
+    zero3 = np.zeros(3)
+    up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
     for scheme, label in ((0, "no rotation"), (1, "single-position fwd/rev (seed 003)")):
         res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed,
                           every=100, progress=fil.TextProgress())
         e = runner.nav_errors(res)
-        th = e.time_s / 3600
-        figs = {
-            "position_nmi": e.horizontal_m.max() / earth.NMI_TO_M,
-            "level_arcmin": np.abs(e.att_n_rad[:, :2]).max() / ARCMIN,
-            "heading_arcmin": np.abs(e.att_n_rad[:, 2]).max() / ARCMIN,
-            "velocity_mps": np.abs(e.vel_n_mps[:, :2]).max(),
+        # error theory with the same constant drifts and biases, and split by source
+        theory = {
+            "all constant errors": analysis.predict_static_fil(res, lat, zero3, errors.gyro_bias,
+                                                               errors.accel_bias, grid),
+            "up-gyro drift only": analysis.predict_static_fil(res, lat, zero3, up_only, zero3, grid),
+            "accelerometer biases only": analysis.predict_static_fil(res, lat, zero3, zero3,
+                                                                     errors.accel_bias, grid),
         }
-        rows.append((label, figs))
-        for k, v in figs.items():
-            fig_json[f"{'rot' if scheme else 'norot'}_max_{k}"] = float(v)
+        tag = "rot" if scheme else "norot"
+        rows.append((f"ours, {label}", figures(e)))
+        for k, v in rows[-1][1].items():
+            fig_json[f"{tag}_max_{k}"] = float(v)
+        # the same run with the constant drifts and biases only: what theory covers
+        res_b = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), seed=args.seed, every=100,
+                            errors=sim.SensorErrors(gyro_bias=errors.gyro_bias,
+                                                    accel_bias=errors.accel_bias))
+        rows.append((f"ours, {label}, constant drifts and biases only", figures(runner.nav_errors(res_b))))
+        for k, v in rows[-1][1].items():
+            fig_json[f"{tag}_biases_only_max_{k}"] = float(v)
+        for what, th_err in theory.items():
+            rows.append((f"error theory, {label}, {what}", figures(th_err)))
+            for k, v in rows[-1][1].items():
+                fig_json[f"{tag}_theory_{what.split()[0].replace('-', '_')}_max_{k}"] = float(v)
+        th = e.time_s / 3600
         ax[0].plot(th, e.horizontal_m / earth.NMI_TO_M, label=label)
+        ax[0].plot(grid / 3600, theory["all constant errors"].horizontal_m / earth.NMI_TO_M, ":",
+                   label=f"error theory, {label}")
         ax[1].plot(th, np.abs(e.att_n_rad[:, :2]).max(axis=1) / ARCMIN, label=label)
         ax[2].plot(th, e.att_n_rad[:, 2] / ARCMIN, label=label)
         ax[3].plot(th, np.hypot(e.vel_n_mps[:, 0], e.vel_n_mps[:, 1]), label=label)
     for a, yl in zip(ax, ["horizontal position error [nmi]", "max |level error| [arcmin]",
                           "heading error [arcmin]", "horizontal velocity error [m/s]"]):
         a.set_ylabel(yl)
+        a.grid(alpha=0.3)
         a.legend(fontsize=8)
     ax[3].set_xlabel("time [h]")
-    fg.suptitle("seed 003: static ship, 24 h, its sensor errors")
+    fg.suptitle(f"seed 003: static ship at {34.246} N, {args.hours:g} h, its sensor errors")
     fg.tight_layout()
     fg.savefig(os.path.join(args.out, "errors.png"), dpi=100)
+
     md = ["| | max position (nmi) | max level (') | max heading (') | max velocity (m/s) |",
           "|---|---|---|---|---|",
           f"| paper, rotating (bounds) | < {PAPER['position_nmi']} | < {PAPER['level_arcmin']} | "
           f"< {PAPER['heading_arcmin']} | < {PAPER['velocity_mps']} |"]
     for label, f in rows:
-        md.append(f"| ours, {label} | {f['position_nmi']:.3f} | {f['level_arcmin']:.4f} | "
+        md.append(f"| {label} | {f['position_nmi']:.3f} | {f['level_arcmin']:.4f} | "
                   f"{f['heading_arcmin']:.3f} | {f['velocity_mps']:.4f} |")
-    text = "\n".join(md)
-    print(text)
+    table = "\n".join(md)
+    print(table)
+    ours_rot = fig_json["rot_max_position_nmi"]
+    up_rot = fig_json["rot_theory_up_gyro_max_position_nmi"]
+    all_rot = fig_json["rot_theory_all_max_position_nmi"]
+    pos_b = fig_json["rot_biases_only_max_position_nmi"]
+    lev, lev_b, lev_b0 = (fig_json["rot_max_level_arcmin"], fig_json["rot_biases_only_max_level_arcmin"],
+                          fig_json["norot_biases_only_max_level_arcmin"])
+    lev_t, lev_t0 = fig_json["rot_theory_all_max_level_arcmin"], fig_json["norot_theory_all_max_level_arcmin"]
+    explain = f"""
+## Why our figures differ from the paper's
+
+- **Our simulation agrees with error theory.** The linear static-INS error
+  model (`pyins.analysis.static_error_model`, Qin 2014 sec. 4.2) driven by the
+  same constant drifts and biases, projected through the recorded table angle,
+  predicts {all_rot:.3f} nmi for the rotating IMU; the closed-loop firmware run
+  with those errors only gives {pos_b:.3f} nmi, and {ours_rot:.3f} nmi with the
+  full error set. The gap to the paper is therefore not in our integration.
+- **Rotation about the vertical cannot modulate the up gyro.** With the up
+  gyro's 0.003 deg/h as the *only* error, theory gives {up_rot:.2f} nmi in
+  {args.hours:g} h: the drift component along the Earth's axis (eps_U sin L)
+  feeds a longitude error that grows linearly. The paper's < 1.1 nmi needs a
+  smaller up-axis drift than its stated 0.003 deg/h, a different sign
+  combination of its random-constant drifts (ours are +0.003 deg/h on every
+  axis, one draw), or a shorter effective duration.
+- **Level error.** With the constant drifts and biases only, our level error
+  ({lev_b:.3f}' rotating, {lev_b0:.3f}' fixed) is what theory predicts
+  ({lev_t:.3f}', {lev_t0:.3f}'); it comes from the 20 ug accelerometer bias
+  (nabla/g = 4", i.e. 0.07', plus its Schuler and Earth-rate swings). The
+  single-position scheme halves it, not more: the IMU stops only at 0 deg, so
+  half the time the bias is not modulated. The angle random walk (one draw)
+  and the +-2" installation errors times the 6 deg/s table rate make up the
+  rest of our {lev:.3f}'. The paper's < 0.01' is below what its own 20 ug
+  bias allows; we find no reading of its stated errors that gives it.
+- **Latitude.** The paper does not give its latitude; 34.246 N (seed 002's
+  site) is used. The longitude-error growth scales with the drift component
+  along the Earth's axis, so a lower latitude would give less.
+- **Draw.** The paper's drifts are random constants (随机常值漂移); its figures
+  are one draw, ours another: sign patterns move the no-rotation errors by a
+  factor of a few, the rotating ones much less (only eps_U matters there).
+"""
     with open(os.path.join(args.out, "table.md"), "w") as fh:
-        fh.write(text + "\n")
+        fh.write(table + "\n")
+    with open(os.path.join(args.out, "report.md"), "w") as fh:
+        fh.write(f"# Seed 003 reproduced: single-position rotation vs none, {args.hours:g} h static\n\n"
+                 f"{__doc__.split(chr(10), 2)[2].strip()}\n\n![errors](errors.png)\n\n{table}\n{explain}")
     with open(os.path.join(args.out, "seed003.json"), "w") as fh:
         json.dump(fig_json, fh, indent=2)
+    print(explain)
     print(f"written to {args.out}")
     return 0
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pyins import analysis, fil, runner, sim
-from pyins.reference import attitude, earth
+from pyins.reference import earth
 
 DEG = earth.DEG_TO_RAD
 LAT = 34.0 * DEG
@@ -24,17 +24,8 @@ def test_static_run_matches_linear_error_model(scheme):
     errors = sim.SensorErrors(gyro_bias=np.full(3, 0.01 * earth.DPH_TO_RPS))
     res = fil.run_fil(m, 24 * 360_000, config=dict(index_scheme=scheme), errors=errors, every=100)
     e = runner.nav_errors(res)
-    mat_nb = attitude.euler_to_mat([0.0, 0.0, YAW])
-    rec_t = np.concatenate([[0.0], res.plant["tick"] * 0.01])
-    rec_a = np.concatenate([[0.0], res.plant["alpha_rad"]])
-
-    def eps_n(t):
-        alpha = np.interp(t, rec_t, rec_a)      # the table turns at constant rate between records
-        c, s = np.cos(alpha), np.sin(alpha)
-        b = errors.gyro_bias
-        eps_p_in_b = np.column_stack([c * b[0] - s * b[1], s * b[0] + c * b[1], np.full_like(t, b[2])])
-        return eps_p_in_b @ mat_nb.T
-
+    eps_n = analysis.table_projected(errors.gyro_bias, [0.0, 0.0, YAW], res.plant["tick"] * 0.01,
+                                     res.plant["alpha_rad"])
     grid = np.arange(1, 25) * 3600.0
     model = analysis.static_error_model(LAT, grid, eps_n, step_s=0.5)
     k_sim = (HOURS * 3600).astype(int) - 1      # records every 1 s from t = 1 s
