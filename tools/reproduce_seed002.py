@@ -7,11 +7,18 @@ Experiments 1 and 2 (heading swing omega = 6 cos(pi t/60) and 6 cos(pi t/30)
 deg/s), its Table 1 initial state and initial errors (pitch/roll/heading
 -10", 10", 1'; velocity 0.01 m/s; position 10 m north and east), its Table 2
 sensor errors (preset seed002), for no rotation, the traditional two-position
-scheme and the flexible scheme (stops 300 s, 6 deg/s). Also the isolated
-comparison: the horizontal gyro drifts (0.003 deg/h) as the only error.
+scheme and the flexible scheme (stops 300 s, 6 deg/s), literal (SPEC 1.6,
+scheme 4) and in the form of its derivation (eqs. 9-13, scheme 6). The
+paper's turns run at a constant 6 deg/s: we command 600 deg/s^2, which
+reaches 6 deg/s within one 10-ms tick (the firmware default, 30 deg/s^2,
+lengthens each cycle by 0.8 s; why that matters is in the report). Also the
+isolated comparison (the horizontal gyro drifts, 0.003 deg/h, as the only
+error, under both accelerations) and a split of the Table 2 result by
+source (up-gyro drift; scale-factor and installation errors).
 
 Writes positions.png, table.md (final and maximum horizontal errors beside
-the paper's 8.57 / 3.70 / 2.97 and 16.13 / 12.90 / 1.98 nmi) and seed002.json.
+the paper's 8.57 / 3.70 / 2.97 and 16.13 / 12.90 / 1.98 nmi), report.md
+(the tables and why each figure differs from the paper's) and seed002.json.
 SPEC.md 1.7-1.10 explains why experiment 2's traditional result may not
 reproduce; nothing is tuned to match.
 """
@@ -23,12 +30,17 @@ import sys
 import numpy as np
 
 from pyins import fil, runner, sim
+from pyins.sim.turntable import TableConfig
 from pyins.reference import attitude, earth
 
 DEG = earth.DEG_TO_RAD
 ARCSEC = earth.ARCSEC_TO_RAD
 PAPER = {1: (8.57, 3.70, 2.97), 2: (16.13, 12.90, 1.98)}
-SCHEMES = ((0, "no rotation"), (2, "traditional two-position"), (4, "flexible two-position"))
+SCHEMES = ((0, "no rotation"), (2, "traditional two-position"), (4, "flexible two-position"),
+           (6, "flexible, derivation form"))
+PAPER_ACCEL = 600.0 * DEG        # 6 deg/s within one tick: the paper's constant-rate turns
+DEFAULT_ACCEL = 30.0 * DEG       # the firmware default
+PLANT_ACCEL = 1000.0 * DEG       # a motor that can follow PAPER_ACCEL
 
 
 def initial_errors(m):
@@ -38,6 +50,121 @@ def initial_errors(m):
     rm, rn = earth.principal_radii(np.sin(st.lat[0]))
     return dict(euler_b_rad=e, vel_n_mps=[0.01, 0.01, 0.0],
                 lat_rad=st.lat[0] + 10.0 / rm, lon_rad=st.lon[0] + 10.0 / (rn * np.cos(st.lat[0])))
+
+
+def error_sets():
+    """The error sets run, name -> (SensorErrors, with Table 1 initial errors)."""
+    t2 = sim.preset("seed002")
+    drift = 0.003 * earth.DPH_TO_RPS
+    return {
+        "table2": (t2, True),
+        "hdrift": (sim.SensorErrors(gyro_bias=np.array([drift, drift, 0.0])), False),
+        "updrift": (sim.SensorErrors(gyro_bias=np.array([0.0, 0.0, drift])), False),
+        "sf_mis": (sim.SensorErrors(gyro_scale=t2.gyro_scale, gyro_misalignment=t2.gyro_misalignment,
+                                    accel_scale=t2.accel_scale,
+                                    accel_misalignment=t2.accel_misalignment), False),
+    }
+
+
+SET_LABEL = {"table2": "Table 2 (all), Table 1 initial errors", "hdrift": "horizontal gyro drifts only",
+             "updrift": "up-gyro drift only", "sf_mis": "scale-factor and installation errors only"}
+
+
+def run_one(exp, scheme, errors, with_init, accel, hours, seed):
+    m = sim.HeadingSwing.experiment(exp)
+    cfg = dict(index_scheme=scheme, index_accel_rad_s2=accel)
+    if with_init:
+        cfg.update(initial_errors(m))
+    res = fil.run_fil(m, int(hours * 360_000), config=cfg, errors=errors, seed=seed, every=100,
+                      table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=fil.TextProgress())
+    e = runner.nav_errors(res)
+    psi = np.asarray(res.outputs["yaw_p_rad"])
+    # SPEC 1.10's proxy: the fraction of a constant x/y drift that survives
+    # modulation, |integral of [cos, sin] of the IMU heading| / duration
+    surv = float(np.hypot(np.cos(psi).sum(), np.sin(psi).sum()) / len(psi))
+    return dict(final_nmi=float(e.horizontal_m[-1] / earth.NMI_TO_M),
+                max_nmi=float(e.horizontal_m.max() / earth.NMI_TO_M),
+                survives=surv, fallbacks=int(res.outputs["index_fallbacks"][-1]),
+                index_faults=int(np.count_nonzero(res.outputs["index_fault"]))), e
+
+
+def explain(r, hours):
+    """Why each figure differs from the paper's, from the measured figures."""
+    def g(exp, es, sch, acc="paper", k="final_nmi"):
+        return r[(exp, es, sch, acc)][k]
+    lines = ["## Why our figures differ from the paper's", ""]
+    for exp in (1, 2):
+        no, tr, fl, fd = (g(exp, "table2", s) for s in (0, 2, 4, 6))
+        p_no, p_tr, p_fl = PAPER[exp]
+        up = [g(exp, "updrift", s) for s in (0, 2, 4, 6)]
+        sfm = [g(exp, "sf_mis", s) for s in (0, 2, 4, 6)]
+        hd = [g(exp, "hdrift", s, k="max_nmi") for s in (0, 2, 4, 6)]
+        sv = [g(exp, "hdrift", s, k="survives") for s in (0, 2, 4, 6)]
+        lines += [f"### Experiment {exp}", "",
+                  f"- **No rotation**: ours {no:.2f} nmi, the paper {p_no:.2f}. The drifts are random "
+                  "constants (随机常值漂移) in the paper, one draw; ours are +0.003 deg/h on every "
+                  "axis. Their signs decide how the sources add: see the split below.",
+                  f"- **What rotation cannot remove**: the up gyro's drift alone gives "
+                  f"{up[0]:.2f} / {up[1]:.2f} / {up[2]:.2f} / {up[3]:.2f} nmi (none / traditional / "
+                  "flexible / derivation form) in "
+                  f"{hours:g} h: a vertical-axis table does not modulate it (its component along "
+                  "the Earth's axis feeds a growing longitude error). It is the same for every "
+                  "scheme and sets a floor the paper's figures do not show.",
+                  f"- **Heading-correlated errors**: the scale-factor and installation errors alone "
+                  f"give {sfm[0]:.2f} / {sfm[1]:.2f} / {sfm[2]:.2f} / {sfm[3]:.2f} nmi. Times the "
+                  "6 deg/s heading swing and the table rate they act like drifts that move with "
+                  "the heading; no scheme is designed against them.",
+                  f"- **Horizontal drifts only** (the effect the paper's analysis is about): max "
+                  f"{hd[0]:.3f} / {hd[1]:.3f} / {hd[2]:.3f} / {hd[3]:.3f} nmi; the fraction of a "
+                  f"constant x/y drift that survives (SPEC 1.10's proxy): {sv[0]:.4f} / {sv[1]:.4f} / "
+                  f"{sv[2]:.4f} / {sv[3]:.4f}."]
+        hd30 = [g(exp, "hdrift", s, "default", "max_nmi") for s in (0, 2, 4, 6)]
+        sv30 = [g(exp, "hdrift", s, "default", "survives") for s in (0, 2, 4, 6)]
+        if exp == 1:
+            lines += [
+                f"- **The traditional scheme and the swing period lock** when the turns take "
+                f"exactly 30 s: a cycle is then 4 x 330 s = 1320 s = 11 swing periods, every cycle "
+                f"sees the swing at the same phases and a constant part of the drift survives "
+                f"({sv[1]:.4f}; SPEC 1.10 found 0.083 with the same ideal turns). With the "
+                f"firmware's default 30 deg/s^2 each turn takes 0.2 s longer, the phase slips "
+                f"0.8 s per cycle, and over {hours:g} h the residue averages out: survival "
+                f"{sv30[1]:.4f}, max {hd30[1]:.3f} nmi instead of {hd[1]:.3f}. The paper's "
+                f"traditional result depends on this unstated detail.",
+                f"- **Flexible, literal vs derivation form**: the literal cycle (SPEC 1.6) follows "
+                f"each conditional stop by its antipodal fixed stop, so the stopped-time sums "
+                f"swing back each cycle; survival {sv[2]:.4f} (SPEC 1.10: 0.034, the same). The "
+                f"derivation form (eqs. 9-13, no fixed 180-deg moves) keeps the sums near zero: "
+                f"{sv[3]:.4f}. With the paper's turns the literal scheme beats the traditional "
+                f"one by {100 * (1 - hd[2] / hd[1]):.0f} % (max {hd[2]:.3f} vs {hd[1]:.3f} nmi), "
+                f"the derivation form by {100 * (1 - hd[3] / hd[1]):.0f} %; with 30 deg/s^2 turns "
+                f"{100 * (1 - hd30[2] / hd30[1]):.0f} % and {100 * (1 - hd30[3] / hd30[1]):.0f} %.",
+                f"- **With all errors**: ours {tr:.2f} (traditional) and {fl:.2f} / {fd:.2f} nmi "
+                f"(flexible, literal / derivation) beside the paper's {p_tr:.2f} and {p_fl:.2f}. "
+                f"The paper's order (none > traditional > flexible) "
+                f"{'holds' if no > tr > fl else 'does not hold'} for the literal scheme and "
+                f"{'holds' if no > tr > fd else 'does not hold'} for the derivation form; the sizes "
+                f"follow from the split above."]
+        else:
+            lines += [
+                f"- **Why the traditional scheme does not fail here** (the paper: {p_tr:.2f} nmi, "
+                f"'basically fails'): the decoded swing has a 60 s period, and every 300-s stop "
+                f"covers exactly 5 periods, so the x/y drift cancels almost perfectly "
+                f"(survival {sv[1]:.4f}, {hd[1]:.3f} nmi with horizontal drifts only; SPEC 1.7 and "
+                f"1.10 predicted this). The paper's text says the swing period equals the stop "
+                f"time, which the decoded formula does not give; nothing was changed to match.",
+                f"- **With all errors**: ours {tr:.2f} (traditional) and {fl:.2f} / {fd:.2f} nmi "
+                f"(flexible, literal / derivation) beside the paper's {p_tr:.2f} and {p_fl:.2f}. "
+                f"What remains of ours is the up-gyro drift ({up[1]:.2f} nmi alone) and the "
+                f"heading-correlated errors ({sfm[1]:.2f} / {sfm[2]:.2f} nmi alone)."]
+        lines.append("")
+    lines += ["### Common to both", "",
+              "- Latitude 34.246 N, 380 m (Table 1); the vertical channel is held at the true "
+              "height (the paper does not say how it treats it).",
+              "- The paper does not say whether its figures are final or maximum errors: both are "
+              "in the table.",
+              "- Nothing is tuned to match: each figure is what the firmware gives on the "
+              "simulated data."]
+    return "\n".join(lines) + "\n"
 
 
 def main(argv=None):
@@ -51,42 +178,51 @@ def main(argv=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    ticks = int(args.hours * 360_000)
-    out = {"hours": args.hours}
-    md = ["| experiment | errors | scheme | final (nmi) | max (nmi) | paper (nmi) |", "|---|---|---|---|---|---|"]
+    plan = [("table2", "paper"), ("hdrift", "paper"), ("hdrift", "default"), ("updrift", "paper"),
+            ("sf_mis", "paper")]
+    accels = {"paper": PAPER_ACCEL, "default": DEFAULT_ACCEL}
+    sets = error_sets()
+    results, out = {}, {"hours": args.hours, "paper_accel_deg_s2": PAPER_ACCEL / DEG,
+                        "default_accel_deg_s2": DEFAULT_ACCEL / DEG}
+    md = ["| experiment | errors | turn acceleration | scheme | final (nmi) | max (nmi) | paper (nmi) "
+          "| drift surviving |", "|---|---|---|---|---|---|---|---|"]
     fg, ax = plt.subplots(2, 2, figsize=(12, 8), sharex=True)
     for col, exp in enumerate((1, 2)):
-        m = sim.HeadingSwing.experiment(exp)
-        for row, (kind, errors) in enumerate((
-                ("Table 2", sim.preset("seed002")),
-                ("horizontal drifts only", sim.SensorErrors(gyro_bias=np.array([1.0, 1.0, 0.0]) * 0.003 *
-                                                             earth.DPH_TO_RPS)))):
-            for (scheme, label), paper in zip(SCHEMES, PAPER[exp]):
-                cfg = dict(index_scheme=scheme)
-                if row == 0:
-                    cfg.update(initial_errors(m))
-                res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=args.seed, every=100,
-                                  progress=fil.TextProgress())
-                e = runner.nav_errors(res)
-                fin, mx = e.horizontal_m[-1] / earth.NMI_TO_M, e.horizontal_m.max() / earth.NMI_TO_M
-                key = f"exp{exp}_{'table2' if row == 0 else 'hdrift'}_{label.split()[0]}"
-                out[f"{key}_final_nmi"], out[f"{key}_max_nmi"] = float(fin), float(mx)
-                out[f"{key}_fallbacks"] = int(res.outputs["index_fallbacks"][-1])
-                md.append(f"| {exp} | {kind} | {label} | {fin:.3f} | {mx:.3f} | "
-                          f"{paper if row == 0 else ''} |")
-                ax[row, col].plot(e.time_s / 3600, e.horizontal_m / earth.NMI_TO_M, label=label)
+        for es, acc in plan:
+            errors, with_init = sets[es]
+            for scheme, label in SCHEMES:
+                f, e = run_one(exp, scheme, errors, with_init, accels[acc], args.hours, args.seed)
+                results[(exp, es, scheme, acc)] = f
+                key = f"exp{exp}_{es}_{acc}accel_scheme{scheme}"
+                for k, v in f.items():
+                    out[f"{key}_{k}"] = v
+                paper = PAPER[exp][[0, 2, 4].index(scheme)] if es == "table2" and scheme != 6 else ""
+                md.append(f"| {exp} | {SET_LABEL[es]} | {accels[acc] / DEG:g} deg/s^2 | {label} | "
+                          f"{f['final_nmi']:.3f} | {f['max_nmi']:.3f} | {paper} | {f['survives']:.4f} |")
                 print(md[-1], flush=True)
-            ax[row, col].set_title(f"experiment {exp}, {kind}")
-            ax[row, col].set_ylabel("horizontal error [nmi]")
-            ax[row, col].legend(fontsize=8)
+                if acc == "paper" and es in ("table2", "hdrift"):
+                    row = 0 if es == "table2" else 1
+                    ax[row, col].plot(e.time_s / 3600, e.horizontal_m / earth.NMI_TO_M, label=label)
+                    ax[row, col].set_title(f"experiment {exp}, {SET_LABEL[es]}", fontsize=9)
+                    ax[row, col].set_ylabel("horizontal error [nmi]")
+    for a in ax.flat:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
     ax[1, 0].set_xlabel("time [h]")
     ax[1, 1].set_xlabel("time [h]")
     fg.tight_layout()
     fg.savefig(os.path.join(args.out, "positions.png"), dpi=100)
+    table = "\n".join(md) + "\n"
+    why = explain(results, args.hours)
     with open(os.path.join(args.out, "table.md"), "w") as fh:
-        fh.write("\n".join(md) + "\n")
+        fh.write(table)
+    with open(os.path.join(args.out, "report.md"), "w") as fh:
+        fh.write(f"# Seed 002 reproduced: no rotation, traditional and flexible two-position, "
+                 f"{args.hours:g} h\n\n{chr(10).join(__doc__.split(chr(10) * 2)[2:]).strip()}\n\n"
+                 f"![positions](positions.png)\n\n{table}\n{why}")
     with open(os.path.join(args.out, "seed002.json"), "w") as fh:
         json.dump(out, fh, indent=2)
+    print(why)
     print(f"written to {args.out}")
     return 0
 
