@@ -11,6 +11,7 @@ compiled plant (``csrc/plant``, mirrored by ``pyins.sim.turntable``). Only
 decimated records (every ``every`` ticks) come back, so memory stays bounded
 for any duration.
 """
+import hashlib
 import json
 import math
 import os
@@ -108,8 +109,72 @@ def _table_struct(table):
     return t
 
 
+CHECKPOINT = "checkpoint.json"
+CHECKPOINT_VERSION = 1
+
+
+def _run_digest(motion, duration_ticks, cfg, errors, seed, table, every, chunk_ticks, dt, nodes):
+    """What a checkpoint must match to be resumed: everything that decides
+    the records (a checkpoint of another run is refused, never mixed in)."""
+    def plain(v):
+        if isinstance(v, np.ndarray):
+            return hashlib.sha256(np.ascontiguousarray(v).tobytes()).hexdigest() + str(v.shape)
+        if isinstance(v, dict):
+            return {k: plain(x) for k, x in sorted(v.items())}
+        if isinstance(v, (list, tuple)):
+            return [plain(x) for x in v]
+        if hasattr(v, "__dict__"):      # public attributes only: caches filled later are private
+            return {k: plain(x) for k, x in sorted(vars(v).items()) if not k.startswith("_")}
+        return v if isinstance(v, (int, float, str, bool, type(None))) else repr(v)
+    blob = json.dumps(plain(dict(motion=type(motion).__name__, motion_state=motion,
+                                 ticks=int(duration_ticks), cfg=cfg, errors=errors, seed=seed,
+                                 table=table, every=every, chunk=chunk_ticks, dt=dt, nodes=nodes)),
+                      sort_keys=True, default=repr)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def _write_atomic(path, text):
+    """Write ``text`` to ``path`` through a temporary file and a rename, so a
+    kill at any moment leaves either the old file or the new one."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def _records_json(record_dir, every, dt, duration_ticks, done):
+    _write_atomic(os.path.join(record_dir, "records.json"), json.dumps(
+        {"outputs.bin": str(native.OUTPUT_DTYPE.descr), "plant.bin": str(PLANT_RECORD_DTYPE.descr),
+         "every_ticks": every, "dt_s": dt, "ticks": int(duration_ticks), "ticks_done": int(done),
+         "complete": bool(done >= duration_ticks)}, indent=2))
+
+
+def load_records(record_dir):
+    """The records a run streamed to ``record_dir`` (complete or not), memory-
+    mapped, cut to the last checkpointed or completed tick: (outputs, plant,
+    info) with info the records.json dict."""
+    with open(os.path.join(record_dir, "records.json")) as f:
+        info = json.load(f)
+    ck = os.path.join(record_dir, CHECKPOINT)
+    n = None
+    if os.path.exists(ck) and not info.get("complete"):
+        with open(ck) as f:
+            n = json.load(f)["n_records"]
+    arrays = []
+    for name, dtype in (("outputs.bin", native.OUTPUT_DTYPE), ("plant.bin", PLANT_RECORD_DTYPE)):
+        path = os.path.join(record_dir, name)
+        count = os.path.getsize(path) // dtype.itemsize
+        count = count if n is None else min(n, count)
+        arrays.append(np.memmap(path, dtype=dtype, mode="r", shape=(count,)) if count
+                      else np.zeros(0, dtype=dtype))
+    return arrays[0], arrays[1], info
+
+
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
-            chunk_ticks=500_000, dt=0.01, nodes=5, progress=None, record_dir=None):
+            chunk_ticks=500_000, dt=0.01, nodes=5, progress=None, record_dir=None,
+            checkpoint_ticks=None, resume=False):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -122,7 +187,22 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     (raw OUTPUT_DTYPE / PLANT_RECORD_DTYPE, described in ``records.json``)
     chunk by chunk and returned memory-mapped, so memory stays bounded for
     any duration. Returns a FilResult.
+
+    Checkpoints (need ``record_dir``): every ``checkpoint_ticks`` (rounded up
+    to whole chunks) the firmware snapshot, the plant state, the noise
+    generator's state and the number of records written go to
+    ``checkpoint.json`` (temporary file + rename, after the records are
+    flushed to disk). With ``resume=True`` a run killed at any moment
+    continues from its last checkpoint: the records written after it are cut
+    off and recomputed, and the result is bit-identical to an uninterrupted
+    run. A checkpoint of a different run (other motion, errors, seed,
+    configuration, chunking) is refused with ValueError. The plant state is
+    stored as raw bytes: resume on the machine kind that wrote it.
     """
+    if (checkpoint_ticks is not None or resume) and record_dir is None:
+        raise ValueError("run_fil: checkpoint_ticks and resume need record_dir")
+    if checkpoint_ticks is not None and checkpoint_ticks <= 0:
+        raise ValueError(f"run_fil: checkpoint_ticks must be > 0, got {checkpoint_ticks}")
     if native.plant is None:
         raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
     ffi = native.ffi
@@ -145,13 +225,36 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     x_c = w_c = None
     outs, recs = [], []
     sinks = None
+    done = 0
+    n_records = 0
     if record_dir is not None:
         os.makedirs(record_dir, exist_ok=True)
-        sinks = (open(os.path.join(record_dir, "outputs.bin"), "wb"),
-                 open(os.path.join(record_dir, "plant.bin"), "wb"))
+        digest = _run_digest(motion, duration_ticks, cfg, errors, seed, table, every, chunk_ticks,
+                             dt, nodes)
+        ck_path = os.path.join(record_dir, CHECKPOINT)
+        mode = "wb"
+        if resume and os.path.exists(ck_path):
+            with open(ck_path) as f:
+                ck = json.load(f)
+            if ck.get("version") != CHECKPOINT_VERSION or ck.get("run_digest") != digest:
+                raise ValueError(f"{ck_path}: the checkpoint belongs to another run (motion, errors, "
+                                 "seed, configuration or chunking differ); remove it or use another "
+                                 "record_dir")
+            fw.restore(bytes.fromhex(ck["firmware"]))
+            ffi.memmove(st, bytes.fromhex(ck["plant"]), ffi.sizeof("pyins_plant_state"))
+            rng.bit_generator.state = ck["rng"]
+            done, n_records = ck["done_ticks"], ck["n_records"]
+            mode = "r+b"
+        sinks = (open(os.path.join(record_dir, "outputs.bin"), mode),
+                 open(os.path.join(record_dir, "plant.bin"), mode))
+        for f, dtype in zip(sinks, (native.OUTPUT_DTYPE, PLANT_RECORD_DTYPE)):
+            f.truncate(n_records * dtype.itemsize)     # drop what was written after the checkpoint
+            f.seek(n_records * dtype.itemsize)
+        if mode == "wb" and os.path.exists(ck_path):
+            os.remove(ck_path)
+        last_ck = done
     n_done_p = ffi.new("size_t *")
     n_out_p = ffi.new("size_t *")
-    done = 0
     while done < duration_ticks:
         n = min(chunk_ticks, duration_ticks - done)
         if period is None:
@@ -181,6 +284,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         if sinks is not None:
             sinks[0].write(out[:n_out_p[0]].tobytes())
             sinks[1].write(rec[:n_out_p[0]].tobytes())
+            n_records += n_out_p[0]
         else:
             outs.append(out[:n_out_p[0]].copy())
             recs.append(rec[:n_out_p[0]].copy())
@@ -190,17 +294,27 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
                     f.close()
             raise native.CoreError(status, f"pyins_fil_run at tick {done + n_done_p[0]}")
         done += n
+        if sinks is not None and (done >= duration_ticks or
+                                  (checkpoint_ticks is not None and done - last_ck >= checkpoint_ticks)):
+            for f in sinks:
+                f.flush()
+                os.fsync(f.fileno())
+            if checkpoint_ticks is not None or resume:
+                _write_atomic(ck_path, json.dumps(dict(
+                    version=CHECKPOINT_VERSION, run_digest=digest, done_ticks=done, n_records=n_records,
+                    firmware=fw.snapshot().hex(),
+                    plant=bytes(ffi.buffer(st, ffi.sizeof("pyins_plant_state"))).hex(),
+                    rng=rng.bit_generator.state)))
+            _records_json(record_dir, every, dt, duration_ticks, done)
+            last_ck = done
         if progress is not None:
             progress(done, duration_ticks)
     if sinks is not None:
         for f in sinks:
             f.close()
-        with open(os.path.join(record_dir, "records.json"), "w") as f:
-            json.dump({"outputs.bin": str(native.OUTPUT_DTYPE.descr),
-                       "plant.bin": str(PLANT_RECORD_DTYPE.descr),
-                       "every_ticks": every, "dt_s": dt, "ticks": int(duration_ticks)}, f, indent=2)
-        outputs = np.memmap(os.path.join(record_dir, "outputs.bin"), dtype=native.OUTPUT_DTYPE, mode="r")
-        plant = np.memmap(os.path.join(record_dir, "plant.bin"), dtype=PLANT_RECORD_DTYPE, mode="r")
+        if done >= duration_ticks and not os.path.exists(os.path.join(record_dir, "records.json")):
+            _records_json(record_dir, every, dt, duration_ticks, done)
+        outputs, plant, _ = load_records(record_dir)
     else:
         outputs = np.concatenate(outs)
         plant = np.concatenate(recs)
