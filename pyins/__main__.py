@@ -1,13 +1,21 @@
 """Command line entry point: ``pyins`` / ``python -m pyins``.
 
-For now it holds the main job run by ``tools/setup.sh``:
+Commands (``pyins COMMAND --help`` shows an example for each; docs/cli.md):
 
-    pyins demo [--hours 2] [--out runs/demo] [--sensors seed002]
+    run SCENARIO       run a built-in scenario or a TOML file into a run directory
+    simulate SCENARIO  write the IMU log of a scenario (open loop, table fixed)
+    replay LOG         run a recorded IMU log through the firmware
+    report RUNDIR      (re)render the plots and report.html of a run directory
+    campaign           grids and Monte-Carlo sets, local process pool or Dask
+    list               built-in scenarios, campaigns, presets, schemes, formats
+    bench              benchmark figures (C++ vs the NumPy reference)
+    demo               the main job of tools/setup.sh (2 h seed-002 swing)
+    version            package and core versions
 
-which simulates seed 002's experiment-1 ship (heading swing of 6 deg/s
-amplitude, 120 s period, at Xi'an) with a sensor error preset, runs it
-through the C++ firmware with the IMU fixed to the ship, prints the
-navigation errors and writes a plot. The full CLI comes with the CLI issue.
+Exit codes: 0 success, 1 a run failed (firmware error), 2 bad input (usage,
+scenario file, log file: one line naming the file, key and reason), 130
+interrupted by Ctrl-C (a valid partial result is left). ``--debug`` shows
+the traceback of an error.
 """
 import argparse
 import json
@@ -86,31 +94,416 @@ def _demo(args):
     return 0
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(prog="pyins", description="pyins: marine rotation-modulated INS firmware")
-    sub = ap.add_subparsers(dest="command", required=True)
-    demo = sub.add_parser("demo", help="run the default scenario through the firmware, print and plot errors",
-                          description="example: pyins demo --hours 2 --sensors seed002")
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+class InputError(Exception):
+    """Bad input from the user: printed as one line, exit code 2."""
+
+
+def _say(args, text):
+    if not getattr(args, "quiet", False) and not getattr(args, "json", False):
+        print(text, flush=True)
+
+
+def _progress(args):
+    from pyins import fil
+    if getattr(args, "quiet", False) or getattr(args, "json", False):
+        return None
+
+    def make(label):
+        print(f"  {label}", file=sys.stderr, flush=True)
+        return fil.TextProgress()
+    return make
+
+
+def _emit_json(args, obj):
+    if getattr(args, "json", False):
+        print(json.dumps(obj, indent=2, default=float))
+
+
+def _summary_lines(summary):
+    from pyins import runs
+    from pyins.reference import earth
+    out = []
+    for v in summary["variants"]:
+        m = v["metrics"]
+        if not m:
+            out.append(f"  {v['label']}: no records")
+            continue
+        out.append(f"  {v['label']}: max horizontal {m['horizontal_error_max']:.1f} m "
+                   f"({m['horizontal_error_max'] / earth.NMI_TO_M:.3f} nmi), "
+                   f"max level {m['level_error_max'] / earth.ARCSEC_TO_RAD:.2f}\", "
+                   f"final heading {m['heading_error_final'] / earth.ARCMIN_TO_RAD:.3f}'"
+                   + ("" if v["complete"] else f"  [partial: {v['ticks_done']} of {v['ticks']} ticks]"))
+    for r in runs.paper_rows(summary):
+        ours = "-" if r["ours"] is None else f"{r['ours']:.4g}"
+        out.append(f"  paper {r['metric']} [{r['variant']}]: {r['relation']} {r['paper']:g} {r['unit']}"
+                   f"; ours {ours} {r['unit']} {r['verdict']}")
+    return out
+
+
+def _default_out(name):
+    return os.path.join("runs", name)
+
+
+def cmd_run(args):
+    from pyins import report, runs, scenario
+    scn = scenario.load(args.scenario)
+    overrides = {}
+    for item in args.set or []:
+        if "=" not in item:
+            raise InputError(f"--set {item!r}: expected KEY=VALUE, e.g. --set duration=\"2 h\"")
+        k, v = item.split("=", 1)
+        overrides[k.strip()] = _toml_value(v.strip(), f"--set {k.strip()}")
+    if args.hours is not None:
+        overrides["duration"] = f"{args.hours} h"
+    if args.seed is not None:
+        overrides["seed"] = args.seed
+    if overrides:
+        scn = scn.with_overrides(overrides)
+    out = args.out or _default_out(scn.name)
+    _say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
+    try:
+        summary = runs.execute(scn, out, progress=_progress(args), resume=args.resume,
+                               log=None if args.quiet or args.json else print)
+    except KeyboardInterrupt:
+        report.render(out)
+        print(f"pyins: interrupted; the partial result is in {out} (resume with --resume)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    path = report.render(out)
+    for line in _summary_lines(summary):
+        _say(args, line)
+    _say(args, f"  report: {path}")
+    _emit_json(args, summary)
+    return EXIT_OK
+
+
+def _toml_value(text, where):
+    """A --set value: TOML syntax if it parses ("2 h" with quotes, 3, [..]),
+    else the bare text as a string (so --set duration=2h needs no quotes)."""
+    import tomllib
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def cmd_simulate(args):
+    import numpy as np
+
+    from pyins import logs, scenario, sim
+    scn = scenario.load(args.scenario)
+    if args.hours is not None:
+        scn = scn.with_overrides({"duration": f"{args.hours} h"})
+    specs = list(scn.runs())
+    if not 0 <= args.variant < len(specs):
+        raise InputError(f"--variant {args.variant}: {scn.name} has {len(specs)} variant(s) (0..{len(specs) - 1})")
+    spec = specs[args.variant]
+    if spec.config.get("index_scheme", 0) != 0:
+        _say(args, f"  note: the indexing scheme of {spec.label!r} is closed loop (the firmware commands the "
+                   "table); the log is written with the table fixed at its initial angle. "
+                   "Use `pyins run` for closed-loop runs.")
+    alpha0 = float(spec.config.get("table_angle_rad", 0.0))
+    sensors = sim.SensorModel(spec.errors, seed=spec.seed)
+    parts = []
+    for chunk in sim.generate(spec.motion, spec.duration_ticks, chunk_ticks=200_000, dt=spec.dt,
+                              table=sim.motion.Fixed(alpha0), sensors=sensors, with_truth=False):
+        parts.append((chunk.tick, chunk.dtheta_p, chunk.dv_p, chunk.table_angle))
+    tick = np.concatenate([p[0] for p in parts])
+    data = sim.io.ImuData(tick=tick.astype(np.int64), dtheta_p=np.concatenate([p[1] for p in parts]),
+                          dv_p=np.concatenate([p[2] for p in parts]),
+                          table_angle_rad=np.concatenate([p[3] for p in parts]), dt=spec.dt,
+                          metadata=dict(scenario=scn.text, scenario_name=scn.name, variant=args.variant,
+                                        digest=scn.digest()))
+    fmt = logs.format_of(args.log, args.format)
+    logs.write_log(args.log, data, fmt)
+    _say(args, f"pyins simulate {scn.name} [{spec.label}]: {len(tick)} samples "
+               f"({len(tick) * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
+    _emit_json(args, dict(log=args.log, format=fmt, samples=int(len(tick)), scenario=scn.name,
+                          variant=spec.label))
+    return EXIT_OK
+
+
+def cmd_replay(args):
+    import numpy as np
+
+    from pyins import logs, native, runner, scenario, sim
+    from pyins.reference import earth
+    read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
+                   axes=args.axes, time_col=args.time_col)
+    if args.table_angle is not None:
+        read_kw["table_angle"] = np.radians(args.table_angle)
+    data = logs.read_log(args.log, args.format, **{k: v for k, v in read_kw.items() if v is not None})
+    scn = None
+    if args.scenario:
+        scn = scenario.load(args.scenario)
+    elif data.metadata.get("scenario"):
+        scn = scenario.loads(data.metadata["scenario"], source=f"{args.log} (metadata)",
+                             name=data.metadata.get("scenario_name"))
+    cfg, motion, spec = {}, None, None
+    if scn is not None:
+        specs = list(scn.runs())
+        spec = specs[int(data.metadata.get("variant", 0)) if not args.scenario else 0]
+        motion = spec.motion
+        cfg = runner.initial_config(motion, None, **spec.config)
+        cfg["index_scheme"] = 0        # a log's table angles are recorded: no commands
+    for name, val in (("lat_rad", args.lat), ("lon_rad", args.lon)):
+        if val is not None:
+            cfg[name] = np.radians(val)
+    if args.height is not None:
+        cfg["height_m"] = args.height
+    if args.attitude is not None:
+        cfg["euler_b_rad"] = np.radians(args.attitude)
+    if args.coarse is not None:
+        cfg["coarse_ticks"] = int(round(args.coarse / (data.dt or 0.01)))
+    if args.fine is not None:
+        cfg["fine_ticks"] = int(round(args.fine / (data.dt or 0.01)))
+    if "lat_rad" not in cfg:
+        raise InputError(f"{args.log}: no initial position: give --scenario or --lat/--lon/--height "
+                         "(and --attitude, or --coarse to align)")
+    fw = native.Firmware(cfg)
+    samples = native.make_samples(np.ascontiguousarray(data.dtheta_p), np.ascontiguousarray(data.dv_p),
+                                  np.ascontiguousarray(data.table_angle_rad))
+    out_dir = args.out or _default_out("replay")
+    os.makedirs(out_dir, exist_ok=True)
+    every = max(1, int(args.every))
+    recs = fw.run(samples, every=every)
+    np.savez(os.path.join(out_dir, "navigation.npz"), outputs=recs)
+    summary = dict(log=os.path.abspath(args.log), samples=int(len(samples)), every=every,
+                   final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
+                              lon_deg=float(np.degrees(recs["lon_rad"][-1])),
+                              euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
+                              mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
+    if motion is not None:
+        truth = sim.truth_at(motion, recs["tick"], dt=spec.dt)
+        e = runner.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=spec.dt))
+        summary["errors"] = dict(horizontal_max_m=float(e.horizontal_m.max()),
+                                 horizontal_final_m=float(e.horizontal_m[-1]),
+                                 heading_final_arcmin=float(e.att_n_rad[-1, 2] / earth.ARCMIN_TO_RAD),
+                                 level_max_arcsec=float(np.abs(e.att_n_rad[:, :2]).max() / earth.ARCSEC_TO_RAD))
+    with open(os.path.join(out_dir, "summary.json"), "w") as f:
+        json.dump(summary, f, indent=2)
+    _say(args, f"pyins replay {args.log}: {len(samples)} samples -> {out_dir}/navigation.npz")
+    fin = summary["final"]
+    _say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, mode {fin['mode']}, "
+               f"faults {fin['fault_flags']}")
+    if "errors" in summary:
+        er = summary["errors"]
+        _say(args, f"  against the scenario's truth: max horizontal {er['horizontal_max_m']:.2f} m, "
+                   f"final heading {er['heading_final_arcmin']:.3f}'")
+    _emit_json(args, summary)
+    return EXIT_OK
+
+
+def cmd_report(args):
+    from pyins import report
+    if not os.path.exists(os.path.join(args.rundir, "summary.json")):
+        raise InputError(f"{args.rundir}: not a run directory (no summary.json)")
+    path = report.render(args.rundir)
+    _say(args, f"report: {path}")
+    _emit_json(args, dict(report=path))
+    return EXIT_OK
+
+
+def cmd_list(args):
+    from pyins import scenario, sim
+    items = dict(scenarios=scenario.list_builtin(), sensor_presets=sorted(sim.PRESETS),
+                 index_schemes=sorted(scenario.INDEX_SCHEMES))
+    try:
+        from pyins import campaign
+        items["campaigns"] = campaign.list_builtin()
+    except ImportError:
+        pass
+    from pyins import logs
+    items["log_formats"] = list(logs.FORMATS)
+    if args.json:
+        _emit_json(args, items)
+        return EXIT_OK
+    print("built-in scenarios (pyins run NAME; the files: pyins list --paths):")
+    for name, title in items["scenarios"]:
+        extra = f"  [{scenario.builtin_path(name)}]" if args.paths else ""
+        print(f"  {name:18s} {title}{extra}")
+    if "campaigns" in items:
+        print("built-in campaigns (pyins campaign NAME):")
+        for name, title in items["campaigns"]:
+            print(f"  {name:18s} {title}")
+    print("sensor presets:", ", ".join(items["sensor_presets"]))
+    print("indexing schemes:", ", ".join(items["index_schemes"]))
+    print("log formats:", ", ".join(items["log_formats"]))
+    return EXIT_OK
+
+
+def cmd_bench(args):
+    from pyins import bench
+    fig = bench.run(seconds=args.seconds)
+    if args.json:
+        _emit_json(args, fig)
+    else:
+        for line in bench.lines(fig):
+            print(line)
+    return EXIT_OK
+
+
+def cmd_campaign(args):
+    from pyins import campaign
+    if args.campaign and (args.grid or args.scenario):
+        raise InputError("campaign: give a campaign (NAME or FILE) or --scenario with --grid, not both")
+    if args.campaign:
+        camp = campaign.load_campaign(args.campaign)
+    elif args.scenario:
+        camp = campaign.from_args(args.scenario, args.grid or [], args.seeds, args.group_by)
+    else:
+        raise InputError("campaign: give a campaign NAME or FILE, or --scenario with --grid (see --help)")
+    out = args.out or _default_out(f"campaign_{camp.name}")
+    _say(args, f"pyins campaign {camp.name} -> {out}")
+
+    def progress(done, total, skipped=0):
+        if not args.quiet and not args.json:
+            print(f"\r  {done}/{total} runs ({skipped} already done)", end="", file=sys.stderr, flush=True)
+    try:
+        result = campaign.run_campaign(camp, out, workers=args.workers, scheduler=args.scheduler,
+                                       progress=progress)
+    except KeyboardInterrupt:
+        print(f"\npyins: interrupted; finished runs are kept in {out}/runs (rerun the same command "
+              "to resume)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if not args.quiet and not args.json:
+        print(file=sys.stderr)
+    _say(args, f"  aggregates: {os.path.join(out, 'aggregate.md')}")
+    _emit_json(args, result)
+    return EXIT_OK
+
+
+EXAMPLES = {
+    "run": "examples:\n  pyins run seed003\n  pyins run my_ship.toml --out runs/my_ship\n"
+           "  pyins run seed002_exp1 --hours 6 --set indexing.stop=\"120 s\"\n"
+           "  pyins run seed002_exp1 --out runs/exp1 --resume   # continue after Ctrl-C or a kill",
+    "simulate": "example:\n  pyins simulate demo imu.npz --hours 0.5\n  pyins simulate seed000_static imu.txt",
+    "replay": "examples:\n  pyins replay imu.npz                       # initial state from the log's scenario\n"
+              "  pyins replay field.txt --kind rates --gyro-unit deg/s --accel-unit g --axes frd \\\n"
+              "      --lat 34.246 --lon 108.91 --height 380 --coarse 150 --fine 600",
+    "report": "example:\n  pyins report runs/seed003",
+    "campaign": "examples:\n  pyins campaign seed000_static\n"
+                "  pyins campaign --scenario seed000_static --grid motion.heading=\"0 deg,60 deg\" --seeds 5\n"
+                "  pyins campaign seed000_static --scheduler tcp://127.0.0.1:8786",
+    "list": "example:\n  pyins list --paths",
+    "bench": "example:\n  pyins bench --seconds 5 --json",
+    "demo": "example:\n  pyins demo --hours 2 --sensors seed002",
+    "version": "example:\n  pyins version",
+}
+
+
+def build_parser():
+    from argparse import RawDescriptionHelpFormatter as Raw
+    ap = argparse.ArgumentParser(prog="pyins", description=__doc__.split("\n\n")[1], formatter_class=Raw)
+    ap.add_argument("--debug", action="store_true", help="show tracebacks")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    def cmd(name, help_):
+        p = sub.add_parser(name, help=help_, description=help_, epilog=EXAMPLES[name], formatter_class=Raw)
+        p.add_argument("--quiet", action="store_true", help="no progress or summary lines")
+        p.add_argument("--json", action="store_true", help="print the result as JSON (implies --quiet)")
+        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks")
+        return p
+
+    p = cmd("run", "run a built-in scenario or a TOML file into a run directory")
+    p.add_argument("scenario", help="built-in name (pyins list) or a .toml file")
+    p.add_argument("--out", help="run directory (default runs/NAME)")
+    p.add_argument("--hours", type=float, help="override the duration [h]")
+    p.add_argument("--seed", type=int, help="override the noise seed")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario key (repeatable)")
+    p.add_argument("--resume", action="store_true", help="continue an interrupted run in --out")
+    p = cmd("simulate", "write the IMU log of a scenario (open loop, table fixed)")
+    p.add_argument("scenario")
+    p.add_argument("log", help="output file: .npz, .csv, .txt, .bin")
+    p.add_argument("--format", help="npz, csv, text, binary (default: from the extension)")
+    p.add_argument("--hours", type=float)
+    p.add_argument("--variant", type=int, default=0, help="which [compare] variant (default 0)")
+    p = cmd("replay", "run a recorded IMU log through the firmware")
+    p.add_argument("log")
+    p.add_argument("--format")
+    p.add_argument("--scenario", help="initial state and truth from this scenario")
+    p.add_argument("--kind", choices=["increments", "rates"])
+    p.add_argument("--gyro-unit")
+    p.add_argument("--accel-unit")
+    p.add_argument("--axes", help="axis mapping, e.g. frd or frd->rfu (default rfu)")
+    p.add_argument("--time-col", choices=["first", "last", "none"])
+    p.add_argument("--dt", type=float, help="sample interval [s] when the log has no time")
+    p.add_argument("--table-angle", type=float, help="a fixed table angle [deg] for logs without one")
+    p.add_argument("--lat", type=float, help="initial latitude [deg]")
+    p.add_argument("--lon", type=float, help="initial longitude [deg]")
+    p.add_argument("--height", type=float, help="initial height [m]")
+    p.add_argument("--attitude", type=float, nargs=3, metavar=("PITCH", "ROLL", "YAW"),
+                   help="initial attitude [deg] (yaw counter-clockwise = -heading)")
+    p.add_argument("--coarse", type=float, help="coarse alignment time [s]")
+    p.add_argument("--fine", type=float, help="fine alignment time [s]")
+    p.add_argument("--every", type=int, default=100, help="record every N samples (default 100 = 1 s)")
+    p.add_argument("--out", help="output directory (default runs/replay)")
+    p = cmd("report", "(re)render the plots and report.html of a run directory")
+    p.add_argument("rundir")
+    p = cmd("campaign", "grids and Monte-Carlo sets on a local process pool or a Dask cluster")
+    p.add_argument("campaign", nargs="?", help="built-in campaign name or a campaign .toml file")
+    p.add_argument("--scenario", help="base scenario for --grid")
+    p.add_argument("--grid", action="append", metavar="KEY=V1,V2,...")
+    p.add_argument("--seeds", type=int, default=1)
+    p.add_argument("--group-by", action="append")
+    p.add_argument("--workers", type=int, help="local processes (default: every core)")
+    p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
+    p.add_argument("--out", help="campaign directory (default runs/campaign_NAME)")
+    p = cmd("list", "list built-in scenarios, campaigns, presets, schemes and log formats")
+    p.add_argument("--paths", action="store_true", help="show where the built-in files are")
+    p = cmd("bench", "print benchmark figures (C++ firmware vs the NumPy reference)")
+    p.add_argument("--seconds", type=float, default=3.0, help="time budget per figure [s]")
+    demo = cmd("demo", "the main job of tools/setup.sh: 2 h of seed 002's swing, errors and a plot")
     demo.add_argument("--hours", type=float, default=2.0, help="ship time [h] (default 2)")
     demo.add_argument("--sensors", default="seed002",
                       help="sensor error preset: error_free, seed000, seed001, seed002, seed003")
     demo.add_argument("--seed", type=int, default=1, help="noise seed")
     demo.add_argument("--out", default=os.path.join("runs", "demo"), help="output directory")
-    demo.add_argument("--quiet", action="store_true", help="no progress line")
-    sub.add_parser("version", help="print the package and core versions")
+    cmd("version", "print the package and core versions")
+    return ap
+
+
+def main(argv=None):
+    ap = build_parser()
     args = ap.parse_args(argv)
-    if args.command == "demo":
-        from pyins import sim
-        if args.sensors not in sim.PRESETS:
-            ap.error(f"--sensors: unknown preset {args.sensors!r} (known: {', '.join(sim.PRESETS)})")
-        if not args.hours > 0:
-            ap.error("--hours: must be positive")
-        return _demo(args)
-    if args.command == "version":
-        from pyins import __version__, native
-        print(f"pyins {__version__}, core {native.version()} (ABI {'.'.join(map(str, native.abi_version()))})")
-        return 0
-    return 2
+    if getattr(args, "json", False):
+        args.quiet = True
+    handlers = dict(run=cmd_run, simulate=cmd_simulate, replay=cmd_replay, report=cmd_report,
+                    campaign=cmd_campaign, list=cmd_list, bench=cmd_bench)
+    try:
+        if args.command == "demo":
+            from pyins import sim
+            if args.sensors not in sim.PRESETS:
+                ap.error(f"--sensors: unknown preset {args.sensors!r} (known: {', '.join(sim.PRESETS)})")
+            if not args.hours > 0:
+                ap.error("--hours: must be positive")
+            return _demo(args)
+        if args.command == "version":
+            from pyins import __version__, native
+            print(f"pyins {__version__}, core {native.version()} (ABI {'.'.join(map(str, native.abi_version()))})")
+            return EXIT_OK
+        return handlers[args.command](args)
+    except KeyboardInterrupt:
+        print("pyins: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as exc:   # one line for the user; --debug for the traceback
+        if args.debug:
+            raise
+        from pyins import native
+        if isinstance(exc, native.CoreError):
+            print(f"pyins {args.command}: firmware error: {exc}", file=sys.stderr)
+            return EXIT_FAILED
+        if isinstance(exc, (InputError, ValueError, OSError, ImportError)):
+            msg = str(exc) if not isinstance(exc, OSError) or not exc.filename else \
+                f"{exc.filename}: {exc.strerror}"
+            print(f"pyins {args.command}: {msg.splitlines()[0] if msg else type(exc).__name__}",
+                  file=sys.stderr)
+            return EXIT_INPUT
+        print(f"pyins {args.command}: internal error {type(exc).__name__}: {exc} (rerun with --debug)",
+              file=sys.stderr)
+        return EXIT_FAILED
 
 
 if __name__ == "__main__":
