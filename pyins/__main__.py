@@ -355,11 +355,11 @@ def cmd_campaign(args):
         camp = campaign.from_args(args.scenario, args.grid or [], args.seeds, args.group_by)
     else:
         raise InputError("campaign: give a campaign NAME or FILE, or --scenario with --grid (see --help)")
-    out = args.out or _default_out(f"campaign_{camp.name}")
+    out = args.out or campaign.default_out_dir(camp)
     _say(args, f"pyins campaign {camp.name} -> {out}")
 
     def progress(done, total, skipped=0):
-        if not args.quiet and not args.json:
+        if not args.quiet and not args.json and sys.stderr.isatty():
             print(f"\r  {done}/{total} runs ({skipped} already done)", end="", file=sys.stderr, flush=True)
     try:
         result = campaign.run_campaign(camp, out, workers=args.workers, scheduler=args.scheduler,
@@ -368,7 +368,7 @@ def cmd_campaign(args):
         print(f"\npyins: interrupted; finished runs are kept in {out}/runs (rerun the same command "
               "to resume)", file=sys.stderr)
         return EXIT_INTERRUPTED
-    if not args.quiet and not args.json:
+    if not args.quiet and not args.json and sys.stderr.isatty():
         print(file=sys.stderr)
     _say(args, f"  aggregates: {os.path.join(out, 'aggregate.md')}")
     _emit_json(args, result)
@@ -446,8 +446,8 @@ def build_parser():
     p.add_argument("campaign", nargs="?", help="built-in campaign name or a campaign .toml file")
     p.add_argument("--scenario", help="base scenario for --grid")
     p.add_argument("--grid", action="append", metavar="KEY=V1,V2,...")
-    p.add_argument("--seeds", type=int, default=1)
-    p.add_argument("--group-by", action="append")
+    p.add_argument("--seeds", help="a count N (0..N-1), a list 0,3,7 or a range 2..6 (default: the scenario's)")
+    p.add_argument("--group-by", action="append", help="grid keys to group by (default: all but seed)")
     p.add_argument("--workers", type=int, help="local processes (default: every core)")
     p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", help="campaign directory (default runs/campaign_NAME)")

@@ -162,3 +162,17 @@ def test_list_and_version(capsys):
     assert {"demo", "seed000_static", "seed001_fine5", "seed002_exp1", "seed002_exp2", "seed003"} <= set(names)
     assert cli.main(["version"]) == 0
     assert "core" in capsys.readouterr().out
+
+
+def test_campaign_from_the_command_line(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert cli.main(["campaign", "--scenario", "seed000_static", "--grid", "motion.heading=0 deg,90 deg",
+                     "--seeds", "2", "--workers", "1", "--out", str(out), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert len(list((out / "runs").iterdir())) == 4 and (out / "aggregate.md").exists()
+    assert len(result["groups"]) == 2
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[campaign]\nscenario = "seed000_static"\nseedz = 3\n')
+    assert cli.main(["campaign", str(bad)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "bad.toml" in err and "seedz" in err, err
