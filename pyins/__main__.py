@@ -133,7 +133,7 @@ def _summary_lines(summary):
             continue
         out.append(f"  {v['label']}: max horizontal {m['horizontal_error_max']:.1f} m "
                    f"({m['horizontal_error_max'] / earth.NMI_TO_M:.3f} nmi), "
-                   f"max level {m['level_error_max'] / earth.ARCSEC_TO_RAD:.2f}\", "
+                   f"final level {m['level_error_final'] / earth.ARCSEC_TO_RAD:.2f}\", "
                    f"final heading {m['heading_error_final'] / earth.ARCMIN_TO_RAD:.3f}'"
                    + ("" if v["complete"] else f"  [partial: {v['ticks_done']} of {v['ticks']} ticks]"))
     for r in runs.paper_rows(summary):

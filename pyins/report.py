@@ -18,7 +18,9 @@ ARCSEC, ARCMIN, NMI = earth.ARCSEC_TO_RAD, earth.ARCMIN_TO_RAD, earth.NMI_TO_M
 UNIT_OF = {"horizontal_error_final": ("m", 1.0), "horizontal_error_max": ("m", 1.0),
            "level_error_final": ("arcsec", ARCSEC), "level_error_max": ("arcsec", ARCSEC),
            "heading_error_final": ("arcmin", ARCMIN), "heading_error_max": ("arcmin", ARCMIN),
-           "velocity_error_max": ("m/s", 1.0), "att_east_gap_final": ("arcmin", ARCMIN),
+           "velocity_error_max": ("m/s", 1.0),
+           "level_error_vs_limit_final": ("arcsec", ARCSEC),
+           "heading_error_vs_limit_final": ("arcmin", ARCMIN), "att_east_gap_final": ("arcmin", ARCMIN),
            "att_up_gap_final": ("arcmin", ARCMIN),
            "drift_north_gap_final": ("deg/h", earth.DPH_TO_RPS),
            "level_error_std": ("arcsec", ARCSEC), "heading_error_std": ("arcmin", ARCMIN)}

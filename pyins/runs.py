@@ -60,6 +60,15 @@ def metrics(spec, res):
              velocity_error_max=float(np.abs(e.vel_n_mps[:, :2]).max()),
              phi_e_final=float(e.att_n_rad[-1, 0]), phi_n_final=float(e.att_n_rad[-1, 1]),
              phi_u_final=float(e.att_n_rad[-1, 2]))
+    if spec.config.get("coarse_ticks", 0) or spec.config.get("fine_ticks", 0):
+        # an alignment's errors against the theoretical limit at the final
+        # true attitude (seed 001 eq. 21; the papers compare with their own
+        # fine alignment, which shares this unobservable part)
+        lim = analysis.alignment_limits(float(res.truth.lat[-1]), res.truth.euler[-1],
+                                        spec.errors.gyro_bias, spec.errors.accel_bias)
+        d = e.att_n_rad[-1] - lim.phi_n
+        m.update(level_error_vs_limit_final=float(np.abs(d[:2]).max()),
+                 heading_error_vs_limit_final=float(abs(d[2])))
     fine = spec.config.get("fine_ticks", 0)
     if fine and isinstance(spec.motion, sim.Static):
         # seed 001: the filter's errors beside the theoretical limits (analysis)

@@ -290,6 +290,10 @@ METRICS = {
     "level_error_std": ("angle", "std of the final pitch and roll errors over the runs of a "
                                  "campaign (seeds, headings)"),
     "heading_error_std": ("angle", "std of the final heading error over the runs of a campaign"),
+    "level_error_vs_limit_final": ("angle", "larger of |phi_E - limit|, |phi_N - limit| at the end "
+                                            "(alignment: against the theoretical limit, which any "
+                                            "alignment shares)"),
+    "heading_error_vs_limit_final": ("angle", "|phi_U - limit| at the end (alignment)"),
     "att_east_gap_final": ("angle", "|phi_E error - theoretical limit| at the end (alignment)"),
     "att_up_gap_final": ("angle", "|phi_U error - theoretical limit| at the end (alignment)"),
     "drift_north_gap_final": ("angular_rate", "|eps_N estimate error - limit| at the end "
