@@ -84,17 +84,18 @@ def plot_alignment(summary, series, path):
     for label, s in aligning.items():
         t, tl = _time_axis(s["time_s"])
         for i in range(3):
-            ax[i].plot(t, s["att_err_n_rad"][:, i] / scale[i], label=label)
+            # |error| on a log axis: the first seconds are degrees, the end arc-seconds
+            ax[i].semilogy(t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9)
             sig = s["outputs"]["kf_sigma"][:, i]
             if np.any(sig > 0):
-                ax[i].plot(t, 3 * sig / scale[i], "k:", lw=0.8)
-                ax[i].plot(t, -3 * sig / scale[i], "k:", lw=0.8)
+                ax[i].semilogy(t, 3 * sig / scale[i], "k:", lw=0.8)
         ax[2].set_xlabel(tl)
     for a, n in zip(ax, names):
-        a.set_ylabel(n)
-        a.grid(alpha=0.3)
+        a.set_ylabel(f"|{n.split(' ')[0]}| {n.split(' ')[1]}")
+        a.grid(alpha=0.3, which="both")
     ax[0].legend(fontsize=8)
-    ax[0].set_title("alignment convergence (dotted: +-3 sigma of the fine-alignment filter)", fontsize=9)
+    ax[0].set_title("alignment convergence: |attitude error| (dotted: 3 sigma of the fine-alignment "
+                    "filter)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
