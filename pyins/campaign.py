@@ -658,25 +658,12 @@ def loads_campaign(text, source="<string>", name=None, relative_to=None):
 
 def builtin_path(name):
     """The path of built-in campaign ``name`` (to copy and edit)."""
-    path = BUILTIN_DIR / f"{name}.toml"
-    if not path.is_file():
-        names = [n for n, _ in list_builtin()]
-        close = difflib.get_close_matches(name, names, n=1)
-        hint = f"; did you mean {close[0]!r}?" if close else ""
-        raise ScenarioError(f"no such file or built-in campaign{hint} (built-ins: {', '.join(names)})",
-                            "", name)
-    return path
+    return scenario_mod.find_builtin(BUILTIN_DIR, name, "campaign", [n for n, _ in list_builtin()])
 
 
 def load_campaign(path_or_name):
     """A Campaign from a campaign .toml file, or the built-in of that name."""
-    path = Path(path_or_name)
-    if not path.is_file():
-        path = builtin_path(str(path_or_name))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f"cannot read: {exc}", "", str(path_or_name)) from None
+    text, path = scenario_mod.read_toml_source(path_or_name, builtin_path)
     return loads_campaign(text, source=str(path), name=path.stem, relative_to=path)
 
 

@@ -1135,27 +1135,38 @@ def loads(text, source="<string>", name=None):
     return Scenario(text, data, source, name or "scenario")
 
 
-def builtin_path(name):
-    """The path of built-in scenario ``name`` (to copy and edit)."""
-    path = BUILTIN_DIR / f"{name}.toml"
+def find_builtin(directory, name, what, names):
+    """``directory/name.toml``, or a ScenarioError naming the built-ins
+    (``what``: "scenario", "campaign")."""
+    path = Path(directory) / f"{name}.toml"
     if not path.is_file():
-        names = [n for n, _ in list_builtin()]
         close = difflib.get_close_matches(name, names, n=1)
         hint = f"; did you mean {close[0]!r}?" if close else ""
-        raise ScenarioError(f"no such file or built-in scenario{hint} (built-ins: {', '.join(names)})",
+        raise ScenarioError(f"no such file or built-in {what}{hint} (built-ins: {', '.join(names)})",
                             "", name)
     return path
 
 
-def load(path_or_name):
-    """A Scenario from a .toml file, or the built-in of that name."""
+def read_toml_source(path_or_name, builtin):
+    """(text, path) of a .toml file, or of the built-in ``builtin(name)``
+    returns the path of; unreadable files raise ScenarioError."""
     path = Path(path_or_name)
     if not path.is_file():
-        path = builtin_path(str(path_or_name))
+        path = builtin(str(path_or_name))
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8"), path
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"cannot read: {exc}", "", str(path_or_name)) from None
+
+
+def builtin_path(name):
+    """The path of built-in scenario ``name`` (to copy and edit)."""
+    return find_builtin(BUILTIN_DIR, name, "scenario", [n for n, _ in list_builtin()])
+
+
+def load(path_or_name):
+    """A Scenario from a .toml file, or the built-in of that name."""
+    text, path = read_toml_source(path_or_name, builtin_path)
     return loads(text, source=str(path), name=path.stem)
 
 
