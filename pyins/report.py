@@ -26,6 +26,13 @@ UNIT_OF = {"horizontal_error_final": ("m", 1.0), "horizontal_error_max": ("m", 1
            "level_error_std": ("arcsec", ARCSEC), "heading_error_std": ("arcmin", ARCMIN)}
 
 
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")              # files only, no display
+    import matplotlib.pyplot as plt
+    return plt
+
+
 def _load(run_dir):
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
@@ -45,9 +52,7 @@ def _time_axis(t_s):
 
 
 def plot_errors(summary, series, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
     big = max((s["horizontal_m"].max() for s in series.values() if len(s["horizontal_m"])), default=0)
     pos_scale, pos_unit = (NMI, "nmi") if big > 0.5 * NMI else (1.0, "m")
     fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
@@ -72,9 +77,7 @@ def plot_errors(summary, series, path):
 
 def plot_alignment(summary, series, path):
     """Attitude errors and the filter's sigma over the alignment (if any)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
     aligning = {k: s for k, s in series.items() if (s["outputs"]["mode"] != 3).any()}
     if not aligning:
         return False
@@ -104,9 +107,7 @@ def plot_alignment(summary, series, path):
 
 def plot_table(summary, series, path):
     """Table angle, IMU heading and A_c/A_s of the rotating variants."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
     turning = {k: s for k, s in series.items()
                if np.any(s["outputs"]["index_state"] != 0) or np.any(s["outputs"]["table_angle_rad"] != 0)}
     if not turning:
@@ -133,9 +134,7 @@ def plot_table(summary, series, path):
 
 def plot_comparison(summary, path):
     """Final and maximum horizontal errors per variant, the paper's beside."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
     vs = [v for v in summary["variants"] if "horizontal_error_max" in v["metrics"]]
     if len(vs) < 2:
         return False
