@@ -151,7 +151,12 @@ Mat3 mat_orthonormalize(const Mat3& m) { return quat_to_mat(mat_to_quat(m)); }
 double yaw_to_heading(double yaw) {
     if (yaw > -kPi && yaw <= kPi) {  // the usual case (yaw from atan2): no fmod
         const double h = -yaw;
-        return (h < 0.0 ? h + kTwoPi : h) + 0.0;  // + 0.0 turns -0.0 into +0.0
+        if (h < 0.0) {
+            // a yaw below half an ulp of 2 pi (4.4e-16) rounds to 2 pi: north
+            const double w = h + kTwoPi;
+            return w < kTwoPi ? w : 0.0;
+        }
+        return h + 0.0;  // + 0.0 turns -0.0 into +0.0
     }
     double h = std::fmod(-yaw, kTwoPi);
     if (h < 0.0) {

@@ -201,7 +201,11 @@ def yaw_to_heading(yaw):
     """Marine heading [rad], clockwise from North in [0, 2 pi), from yaw (CCW)."""
     if -np.pi < yaw <= np.pi:      # the usual case (yaw from atan2): no fmod
         h = -yaw
-        return (h + TWO_PI if h < 0.0 else h) + 0.0   # + 0.0 turns -0.0 into +0.0
+        if h < 0.0:
+            # a yaw below half an ulp of 2 pi (4.4e-16) rounds to 2 pi: north
+            w = h + TWO_PI
+            return w if w < TWO_PI else 0.0
+        return h + 0.0   # + 0.0 turns -0.0 into +0.0
     h = np.fmod(-yaw, TWO_PI)
     if h < 0.0:
         h = h + TWO_PI

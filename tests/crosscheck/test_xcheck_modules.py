@@ -80,6 +80,14 @@ def test_rot_z_and_heading(a):
     assert hooks.lib.pyins_t_heading_to_yaw(a) == attitude.heading_to_yaw(a)
 
 
+def test_heading_of_tiny_yaws():
+    """Yaws below half an ulp of 2 pi give heading 0 (not 2 pi) in both."""
+    for yaw in (5e-324, 6.7e-322, 1e-300, 1e-17, 4.4e-16, 1e-15, -1e-17, 0.0, -0.0):
+        h = hooks.lib.pyins_t_yaw_to_heading(yaw)
+        assert 0.0 <= h < 2 * np.pi
+        assert h == attitude.yaw_to_heading(yaw)
+
+
 def histories():
     return st.builds(strapdown.History, vectors(0.01), vectors(0.5), vectors(0.01), vectors(0.5),
                      st.sampled_from([0, 1, 2]))

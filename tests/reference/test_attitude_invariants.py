@@ -84,6 +84,12 @@ def test_heading_and_yaw():
     assert abs(attitude.heading_to_yaw(90 * deg) + 90 * deg) < 1e-15
     for h in np.linspace(0, 2 * np.pi, 37, endpoint=False):
         assert abs(attitude.yaw_to_heading(attitude.heading_to_yaw(h)) - h) < 1e-14
+    # a yaw a hair west of north (below half an ulp of 2 pi) is heading 0, not
+    # 2 pi (found by the C ABI fuzzer, tests/fuzz/regressions)
+    for yaw in (5e-324, 6.7e-322, 1e-300, 1e-17, 4.4e-16):
+        h = attitude.yaw_to_heading(yaw)
+        assert 0.0 <= h < 2 * np.pi, (yaw, h)
+    assert attitude.yaw_to_heading(1e-15) == 2 * np.pi - 1e-15
 
 
 @given(angle=st.floats(1e-4, np.sqrt(attitude.ROTVEC_SERIES2)), u=unit_vectors())
