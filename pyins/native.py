@@ -19,7 +19,7 @@ import numpy as np
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 6)
+EXPECTED_ABI = (0, 7)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")
@@ -113,6 +113,8 @@ def _numpy_dtype(struct_name):
 
 
 SAMPLE_DTYPE = _numpy_dtype("pyins_sample")
+#: Statuses that reject a sample (batch calls stop there; SampleError).
+_SAMPLE_REJECTED = (lib.PYINS_E_SAMPLE_NONFINITE, lib.PYINS_E_SAMPLE_SATURATED)
 OUTPUT_DTYPE = _numpy_dtype("pyins_output")
 CONFIG_FIELDS = tuple(name for name, _ in ffi.typeof("pyins_config").fields)
 
@@ -133,8 +135,9 @@ class ConfigError(CoreError, ValueError):
 
 
 class SampleError(CoreError, ValueError):
-    """The core rejected a sample; ``index`` is its position, ``outputs`` the
-    records of the samples accepted before it (the state is after those)."""
+    """The core rejected a sample (NaN/Inf, or an increment at or beyond its
+    saturation limit); ``index`` is its position, ``outputs`` the records of
+    the samples handled before it (the state is after those)."""
 
     def __init__(self, code, index, outputs):
         self.index = index
@@ -175,11 +178,14 @@ def _as_float_array(name, value, tail):
     return a
 
 
-def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None):
+def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None, seq=None):
     """Pack per-field arrays into a SAMPLE_DTYPE array, checking each field.
 
     dtheta_p_rad, dv_p_mps: (N, 3) float64 [rad], [m/s]; table_angle_rad:
-    (N,) float64 [rad] or None for a table fixed at 0.
+    (N,) float64 [rad] or None for a table fixed at 0; seq: (N,) integers,
+    the IMU's sample counter (taken modulo 2^32), or None for zeros. The core
+    reads seq only with ``seq_mode=1`` (PYINS_SEQ_CHECK) in its configuration;
+    logs without a counter leave it off.
     """
     dtheta = _as_float_array("dtheta_p_rad", dtheta_p_rad, (3,))
     dv = _as_float_array("dv_p_mps", dv_p_mps, (3,))
@@ -194,6 +200,11 @@ def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None):
         if table.shape[0] != n:
             raise ValueError(f"table_angle_rad: has {table.shape[0]} rows but dtheta_p_rad has {n}")
         samples["table_angle_rad"] = table
+    if seq is not None:
+        counter = np.asarray(seq)
+        if counter.shape != (n,) or not np.issubdtype(counter.dtype, np.integer):
+            raise ValueError(f"seq: expected {n} integers, got dtype {counter.dtype} shape {counter.shape}")
+        samples["seq"] = counter.astype(np.int64) & 0xFFFFFFFF   # modulo 2^32, as the IMU's counter wraps
     return samples
 
 
@@ -284,24 +295,37 @@ class Firmware:
         self._one_sample = np.zeros(1, dtype=SAMPLE_DTYPE)
         self._one_sample_ptr = ffi.cast("pyins_sample *", ffi.from_buffer(self._one_sample))
         self._n_done = ffi.new("size_t *")
+        self.last_status = 0
 
     def _run_decimated(self, samples, every):
         if every < 1:
             raise ValueError(f"every: must be a positive number of ticks, got {every}")
         n = samples.shape[0]
-        capacity = n // every + 1
-        outputs = np.empty(capacity, dtype=OUTPUT_DTYPE)
         n_done = ffi.new("size_t *")
         n_out = ffi.new("size_t *")
-        status = lib.pyins_run_decimated(
-            self._core, ffi.cast("pyins_sample *", ffi.from_buffer(samples)), n, every,
-            ffi.cast("pyins_output *", ffi.from_buffer(outputs, require_writable=True)), capacity,
-            n_done, n_out)
+        parts = []
+        start = 0
+        while True:
+            rest = samples[start:]
+            capacity = (n - start) // every + 1
+            outputs = np.empty(capacity, dtype=OUTPUT_DTYPE)
+            status = lib.pyins_run_decimated(
+                self._core, ffi.cast("pyins_sample *", ffi.from_buffer(rest)), n - start, every,
+                ffi.cast("pyins_output *", ffi.from_buffer(outputs, require_writable=True)), capacity,
+                n_done, n_out)
+            parts.append(outputs[: n_out[0]])
+            start += int(n_done[0])
+            # seq gaps can pass more multiples of `every` than the samples
+            # count: the call stops before overflowing; go on with a new buffer
+            if status == lib.PYINS_E_BUFFER_TOO_SMALL and n_out[0] == capacity:
+                continue
+            break
+        records = parts[0] if len(parts) == 1 else np.concatenate(parts)
         if status != 0:
-            if status == lib.PYINS_E_SAMPLE_NONFINITE:
-                raise SampleError(status, int(n_done[0]), outputs[: n_out[0]].copy())
+            if status in _SAMPLE_REJECTED:
+                raise SampleError(status, start, records.copy())
             raise CoreError(status, "pyins_run_decimated")
-        return outputs[: n_out[0]]
+        return records
 
     def snapshot(self):
         """The whole firmware state as a versioned, checksummed blob (bytes)."""
@@ -349,14 +373,20 @@ class Firmware:
             raise CoreError(status, "pyins_get_output")
         return self._one_out[0].copy()
 
-    def step(self, dtheta_p_rad, dv_p_mps, table_angle_rad=0.0):
-        """One tick; returns its OUTPUT_DTYPE record. SampleError if rejected."""
+    def step(self, dtheta_p_rad, dv_p_mps, table_angle_rad=0.0, seq=0):
+        """One tick; returns its OUTPUT_DTYPE record. SampleError if rejected.
+
+        A PYINS_W_* notice (a bridged gap, a dropped duplicate, ...) is kept
+        in ``last_status``; the record's fault bits and counters show it too.
+        """
         s = self._one_sample
         s["dtheta_p_rad"][0] = _as_float_array("dtheta_p_rad", np.atleast_2d(dtheta_p_rad), (3,))[0]
         s["dv_p_mps"][0] = _as_float_array("dv_p_mps", np.atleast_2d(dv_p_mps), (3,))[0]
         s["table_angle_rad"][0] = float(table_angle_rad)
+        s["seq"][0] = int(seq) & 0xFFFFFFFF
         status = lib.pyins_step(self._core, self._one_sample_ptr, self._one_out_ptr)
-        if status != 0:
+        self.last_status = status
+        if status < 0:
             raise SampleError(status, 0, np.zeros(0, dtype=OUTPUT_DTYPE))
         return self._one_out[0].copy()
 
@@ -367,7 +397,9 @@ class Firmware:
         ``every=k`` one record after each step whose tick is a multiple of k
         (``every=100``: 1 Hz records at 100 Hz, in phase across calls).
         ``outputs`` may be a preallocated array to fill (every=1 only).
-        SampleError at the first rejected sample, carrying the records before it.
+        SampleError at the first rejected sample, carrying the records before
+        it; sample-level notices (seq gaps, duplicates, encoder jumps) do not
+        stop the run: see the records' ``fault_flags`` and ``n_*`` counters.
         """
         samples = _check_samples(samples)
         n = samples.shape[0]
@@ -385,7 +417,7 @@ class Firmware:
                                ffi.from_buffer("pyins_output[]", outputs, require_writable=True),
                                n_done)
         if status != 0:
-            if status == lib.PYINS_E_SAMPLE_NONFINITE:
+            if status in _SAMPLE_REJECTED:
                 raise SampleError(status, int(n_done[0]), outputs[: n_done[0]].copy())
             raise CoreError(status, "pyins_run")
         return outputs

@@ -58,7 +58,9 @@ def navigate(motion, duration_ticks, every=100, sensors=None, table=None, config
     outs = []
     for chunk in sim.generate(motion, duration_ticks, chunk_ticks=chunk_ticks, dt=dt, table=table,
                               sensors=sensors, with_truth=False):
-        samples = native.make_samples(chunk.dtheta_p, chunk.dv_p, chunk.table_angle)
+        # seq: the tick number each sample ends, as an IMU's packet counter
+        # (read only when the configuration sets seq_mode = 1)
+        samples = native.make_samples(chunk.dtheta_p, chunk.dv_p, chunk.table_angle, seq=chunk.tick)
         rec = fw.run(samples, every=every)
         outs.append(rec)
         if progress is not None:

@@ -58,10 +58,10 @@ def main(argv=None):
     t_plant_ref = 0.0
     for i in range(k):
         tp = time.perf_counter()
-        g, a, enc = turntable.plant_tick(tab, st, mats, omega[i], force[i], x, w,
-                                         errors.gyro_arw * z[i, :3], errors.accel_vrw * z[i, 3:], 0.01)
+        g, a, enc, seq = turntable.plant_tick(tab, st, mats, omega[i], force[i], x, w,
+                                              errors.gyro_arw * z[i, :3], errors.accel_vrw * z[i, 3:], 0.01)
         t_plant_ref += time.perf_counter() - tp
-        _, r = ref.step(g, a, enc)
+        _, r = ref.step(g, a, enc, seq)
         st.rate_cmd_rad_s = r["motor_rate_cmd_rad_s"]
     t_ref = (time.perf_counter() - t0) * n / k
     t_plant_ref *= n / k

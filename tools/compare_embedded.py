@@ -5,10 +5,13 @@ and Cortex-M4F under QEMU, on the demo scenario of csrc/embedded.
     .venv/bin/python tools/compare_embedded.py [--host build/host/demo_host]
         [--m7 build-m7/demo.elf] [--m4 build-m4/demo.elf] [--json runs/bench/embedded.json]
 
-Every build prints the same lines (tick, mode, index state and eleven
-doubles as hex every 500 ticks). The Python run replays the scenario's
-integer-only sample generator through the installed package. Any difference
-is a failure naming the first differing tick and field; exit status 1.
+Every build prints the same lines (every 500 samples: the sample number,
+mode, index state, fault bits, tick, the sample-level counters and eleven
+doubles as hex; an "S k status" line for every sample whose status is not
+PYINS_OK). The Python run replays the scenario's integer-only sample
+generator and its fault schedule (csrc/embedded/demo_scenario.c) through the
+installed package. Any difference is a failure naming the first differing
+tick and field; exit status 1.
 """
 import argparse
 import json
@@ -24,13 +27,23 @@ from pyins import native
 FIELDS = ["lat_rad", "lon_rad", "vel_E", "vel_N", "quat_nb_w", "quat_nb_x", "quat_nb_y", "quat_nb_z",
           "kf_x_2", "table_angle_cmd_rad", "index_a_c"]
 TWO_PI = 6.283185307179586
+DEMO_NONE, DEMO_DROP, DEMO_REPEAT, DEMO_NAN, DEMO_SATURATE, DEMO_ENCODER_GLITCH = range(6)
+
+
+def demo_fault(k):
+    """The fault schedule of demo_scenario.c (demo_fault)."""
+    if k == 3000 or k == 19001:
+        return DEMO_REPEAT
+    if k == 14000 or k in (15000, 15001) or 18000 <= k < 18005:
+        return DEMO_DROP
+    return {16000: DEMO_NAN, 17000: DEMO_SATURATE, 23000: DEMO_ENCODER_GLITCH}.get(k, DEMO_NONE)
 
 
 def python_lines():
     """The demo of csrc/embedded/demo_main.c through pyins.native."""
     ffi, lib = native.ffi, native.lib
     cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
-               fine_states=5, index_scheme=2, index_stop_ticks=2000)
+               fine_states=5, index_scheme=2, index_stop_ticks=2000, seq_mode=1)
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
     state = 1
@@ -47,6 +60,7 @@ def python_lines():
     sample = ffi.new("pyins_sample *")
     out = ffi.new("pyins_output *")
     for k in range(24000):
+        fault = demo_fault(k)
         sample.dtheta_p_rad[0] = unit() * k_ang
         sample.dtheta_p_rad[1] = 6.027874130954723e-07 + unit() * k_ang
         sample.dtheta_p_rad[2] = 4.103617522881293e-07 + unit() * k_ang
@@ -54,9 +68,24 @@ def python_lines():
         sample.dv_p_mps[1] = unit() * k_vel
         sample.dv_p_mps[2] = 0.09796698857772466 + unit() * k_vel
         sample.table_angle_rad = enc
-        st = lib.pyins_step(fw.core, sample, out)
-        if st != 0:
-            raise RuntimeError(f"step {k}: {native.status_str(st)}")
+        sample.seq = k + 1
+        if fault == DEMO_NAN:
+            sample.dv_p_mps[0] = float("nan")
+        elif fault == DEMO_SATURATE:
+            sample.dtheta_p_rad[0] = 1.0
+        elif fault == DEMO_ENCODER_GLITCH:
+            sample.table_angle_rad = enc + 0.25
+        steps = 0 if fault == DEMO_DROP else 2 if fault == DEMO_REPEAT else 1
+        for _ in range(steps):
+            st = lib.pyins_step(fw.core, sample, out)
+            if st != 0:
+                lines.append(f"S {k} {st}")
+            if st < 0 and not ((fault == DEMO_NAN and st == lib.PYINS_E_SAMPLE_NONFINITE)
+                               or (fault == DEMO_SATURATE and st == lib.PYINS_E_SAMPLE_SATURATED)):
+                raise RuntimeError(f"step {k}: {native.status_str(st)}")
+        if out.index_state == lib.PYINS_INDEX_FAULT:
+            lib.pyins_index_reset(fw.core)
+            lib.pyins_get_output(fw.core, out)
         enc = out.table_angle_cmd_rad
         while enc >= TWO_PI:
             enc -= TWO_PI
@@ -66,7 +95,10 @@ def python_lines():
             vals = [out.lat_rad, out.lon_rad, out.vel_n_mps[0], out.vel_n_mps[1], *list(out.quat_nb),
                     out.kf_x[2], out.table_angle_cmd_rad, out.index_a_c]
             hexes = " ".join(struct.pack(">d", v).hex() for v in vals)
-            lines.append(f"{k + 1} {out.mode} {out.index_state} {hexes}")
+            counts = "/".join(str(getattr(out, f)) for f in ("n_nonfinite", "n_saturated", "n_seq_gaps",
+                                                            "n_seq_bridged", "n_seq_repeats", "n_seq_lost",
+                                                            "n_encoder_jumps"))
+            lines.append(f"{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {hexes}")
     lines.append("DONE")
     return lines
 
@@ -76,18 +108,21 @@ def run_lines(cmd):
     return res.stdout.strip().splitlines(), res.returncode
 
 
+N_INTS = 6   # sample number, mode, index state, fault bits, tick, counters; then the doubles
+
+
 def first_difference(a, b):
     for la, lb in zip(a, b):
         if la != lb:
             ta, tb = la.split(), lb.split()
-            if len(ta) < 3 or len(tb) < 3 or ta[:1] != tb[:1]:
+            if len(ta) <= N_INTS or len(tb) <= N_INTS or ta[:1] != tb[:1]:
                 return f"line '{la}' vs '{lb}'"
-            for i, (x, y) in enumerate(zip(ta[3:], tb[3:])):
+            for i, (x, y) in enumerate(zip(ta[N_INTS:], tb[N_INTS:])):
                 if x != y:
                     va = struct.unpack(">d", bytes.fromhex(x))[0]
                     vb = struct.unpack(">d", bytes.fromhex(y))[0]
                     return f"tick {ta[0]}, field {FIELDS[i]}: {x} ({va!r}) vs {y} ({vb!r})"
-            return f"tick {ta[0]}: mode/state {ta[1:3]} vs {tb[1:3]}"
+            return (f"tick {ta[0]}: mode/state/faults/tick/counters {ta[1:N_INTS]} vs {tb[1:N_INTS]}")
     if len(a) != len(b):
         return f"{len(a)} lines vs {len(b)} lines"
     return None

@@ -1,7 +1,10 @@
 /* demo_main.c: run the demo scenario through the firmware and print, every
- * DEMO_PRINT_EVERY ticks, the output record's key doubles as hex (the same
- * program on the host and under QEMU on Cortex-M7 and M4F; the lines must
- * be identical). Ends with "DONE" and returns 0, or prints the failing status. */
+ * DEMO_PRINT_EVERY samples, the output record's mode, index state, fault
+ * bits, tick, sample-level counters and key doubles as hex, and one "S" line
+ * per sample whose status is not PYINS_OK (the same program on the host and
+ * under QEMU on Cortex-M7 and M4F; the lines must be identical). An indexing
+ * FAULT (from the scheduled encoder glitch) is reset. Ends with "DONE" and
+ * returns 0, or prints the failing status. */
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
@@ -39,18 +42,38 @@ int main(void) {
     printf("pyins demo, ABI %lx, instance %lu bytes\n", (unsigned long)pyins_abi_version(),
            (unsigned long)pyins_core_size());
     for (k = 0; k < DEMO_TICKS; ++k) {
-        demo_sample(&lcg, enc, &s);
-        st = pyins_step((pyins_core *)g_mem, &s, &out);
-        if (st != PYINS_OK) {
-            printf("FAIL step %lu %d %s\n", (unsigned long)k, st, pyins_status_str(st));
-            return 4;
+        const int fault = demo_fault(k);
+        /* a dropped sample is lost on the way: the core sees the seq gap on the next one */
+        const int steps = fault == DEMO_DROP ? 0 : (fault == DEMO_REPEAT ? 2 : 1);
+        int rep;
+        demo_sample(&lcg, k, enc, &s);
+        for (rep = 0; rep < steps; ++rep) {
+            st = pyins_step((pyins_core *)g_mem, &s, &out);
+            if (st != PYINS_OK) {
+                printf("S %lu %d\n", (unsigned long)k, st);
+            }
+            /* only the scheduled rejections are expected */
+            if (st < 0 && !(fault == DEMO_NAN && st == PYINS_E_SAMPLE_NONFINITE) &&
+                !(fault == DEMO_SATURATE && st == PYINS_E_SAMPLE_SATURATED)) {
+                printf("FAIL step %lu %d %s\n", (unsigned long)k, st, pyins_status_str(st));
+                return 4;
+            }
+        }
+        if (out.index_state == PYINS_INDEX_FAULT) {
+            pyins_index_reset((pyins_core *)g_mem);
+            pyins_get_output((pyins_core *)g_mem, &out);   /* the command after the reset */
         }
         /* ideal table: the encoder reads the commanded angle, wrapped */
         enc = out.table_angle_cmd_rad;
         while (enc >= 6.283185307179586) enc -= 6.283185307179586;
         while (enc < 0.0) enc += 6.283185307179586;
         if ((k + 1u) % DEMO_PRINT_EVERY == 0u) {
-            printf("%lu %ld %ld", (unsigned long)(k + 1u), (long)out.mode, (long)out.index_state);
+            printf("%lu %ld %ld %lx %ld %lu/%lu/%lu/%lu/%lu/%lu/%lu", (unsigned long)(k + 1u), (long)out.mode,
+                   (long)out.index_state, (unsigned long)out.fault_flags, (long)out.tick,
+                   (unsigned long)out.n_nonfinite, (unsigned long)out.n_saturated,
+                   (unsigned long)out.n_seq_gaps, (unsigned long)out.n_seq_bridged,
+                   (unsigned long)out.n_seq_repeats, (unsigned long)out.n_seq_lost,
+                   (unsigned long)out.n_encoder_jumps);
             put_hex(out.lat_rad);
             put_hex(out.lon_rad);
             put_hex(out.vel_n_mps[0]);

@@ -2,6 +2,7 @@
  * representable values: no libm, so every target computes the same bits. */
 #include "demo_scenario.h"
 
+#include <math.h>   /* NAN only: a constant, no libm call */
 #include <string.h>
 
 /* Increments of a level IMU at yaw 0 at 34.246 N, to double precision
@@ -21,6 +22,19 @@ void demo_config(pyins_config *cfg) {
     cfg->fine_states = 5;
     cfg->index_scheme = PYINS_INDEX_TWO_POSITION;
     cfg->index_stop_ticks = 2000;
+    cfg->seq_mode = PYINS_SEQ_CHECK;        /* default gap bridging: up to 2 ticks */
+}
+
+int demo_fault(uint32_t k) {
+    if (k == 3000u) return DEMO_REPEAT;                    /* coarse alignment: dropped, no restart */
+    if (k == 14000u) return DEMO_DROP;                     /* navigation: 1 tick bridged */
+    if (k == 15000u || k == 15001u) return DEMO_DROP;      /* 2 ticks bridged */
+    if (k == 16000u) return DEMO_NAN;                      /* rejected, then bridged */
+    if (k == 17000u) return DEMO_SATURATE;                 /* rejected, then bridged */
+    if (k >= 18000u && k < 18005u) return DEMO_DROP;       /* 5 ticks: beyond the gap, resync */
+    if (k == 19001u) return DEMO_REPEAT;                   /* duplicate in navigation */
+    if (k == 23000u) return DEMO_ENCODER_GLITCH;           /* a jump, indexing FAULT, reset */
+    return DEMO_NONE;
 }
 
 static double lcg_unit(uint64_t *state) {
@@ -29,7 +43,8 @@ static double lcg_unit(uint64_t *state) {
     return (double)((int64_t)(*state >> 43) - (int64_t)(1 << 20));
 }
 
-void demo_sample(uint64_t *state, double encoder_rad, pyins_sample *s) {
+void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, pyins_sample *s) {
+    const int fault = demo_fault(k);
     const double k_ang = 1.0 / 1099511627776.0 / 1048576.0;  /* 2^-60 rad per LCG unit */
     const double k_vel = 1.0 / 1073741824.0 / 1048576.0;     /* 2^-50 m/s per LCG unit */
     s->dtheta_p_rad[0] = lcg_unit(state) * k_ang;
@@ -39,4 +54,13 @@ void demo_sample(uint64_t *state, double encoder_rad, pyins_sample *s) {
     s->dv_p_mps[1] = lcg_unit(state) * k_vel;
     s->dv_p_mps[2] = kDvU + lcg_unit(state) * k_vel;
     s->table_angle_rad = encoder_rad;
+    s->seq = k + 1u;
+    s->reserved = 0u;
+    if (fault == DEMO_NAN) {
+        s->dv_p_mps[0] = NAN;
+    } else if (fault == DEMO_SATURATE) {
+        s->dtheta_p_rad[0] = 1.0;
+    } else if (fault == DEMO_ENCODER_GLITCH) {
+        s->table_angle_rad = encoder_rad + 0.25;   /* 14 deg: beyond index_jump_rad (5 deg) */
+    }
 }

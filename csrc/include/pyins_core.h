@@ -13,7 +13,9 @@
  * marine one, clockwise from North in [0, 2 pi).
  *
  * Every function that can fail returns PYINS_OK (0) or a negative
- * pyins_status with a fixed value; pyins_status_str() names it.
+ * pyins_status with a fixed value; pyins_step() may also return a positive
+ * PYINS_W_* notice (a sample-level fault it handled: docs/core.md,
+ * "Sample-level faults"); pyins_status_str() names them all.
  *
  * The block between CDEF-BEGIN and CDEF-END is read verbatim by Python's
  * cffi (pyins/native.py), so it holds no preprocessor lines.
@@ -26,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 6
+#define PYINS_ABI_VERSION_MINOR 7
 
 #ifdef __cplusplus
 extern "C" {
@@ -38,7 +40,12 @@ extern "C" {
 
 /* CDEF-BEGIN */
 
-/* Status codes. The values are fixed: never renumber, only append. */
+/* Status codes. The values are fixed: never renumber, only append.
+ * Negative: an error; a rejected sample leaves the state as it was and
+ * stops a batch call. Positive (PYINS_W_*): a sample-level notice; the sample
+ * was handled as docs/core.md says (taken with a remedy, or dropped as a
+ * duplicate), the sticky fault bit and counter record it, and batch calls
+ * go on. */
 enum pyins_status {
     PYINS_OK = 0,
     PYINS_E_NULL = -1,              /* a required pointer argument is NULL */
@@ -68,7 +75,14 @@ enum pyins_status {
     PYINS_E_CONFIG_INDEX_STEP = -27,  /* a custom step, stop length, tolerance or timeout out of range */
     PYINS_E_SNAPSHOT_SIZE = -28,      /* snapshot blob truncated, too long, or its buffer too small */
     PYINS_E_SNAPSHOT_VERSION = -29,   /* snapshot of another format or ABI version */
-    PYINS_E_SNAPSHOT_CORRUPT = -30    /* snapshot magic or checksum wrong */
+    PYINS_E_SNAPSHOT_CORRUPT = -30,   /* snapshot magic or checksum wrong */
+    PYINS_E_SAMPLE_SATURATED = -31,   /* an increment at or beyond its saturation limit; the sample was rejected */
+    PYINS_E_CONFIG_SATURATION = -32,  /* a saturation limit negative or not finite */
+    PYINS_E_CONFIG_SEQ = -33,         /* unknown seq_mode, or seq_max_gap_ticks outside 0..100 */
+    PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
+    PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
+    PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
+    PYINS_W_ENCODER_JUMP = 4          /* the encoder changed by more than index_jump_rad per tick; sample taken */
 };
 
 /* Indexing schemes (pyins_config.index_scheme). */
@@ -108,10 +122,22 @@ enum pyins_fine_correction {
     PYINS_FINE_OPEN_LOOP = 1      /* leave it; report the corrected attitude */
 };
 
-/* Bits of pyins_output.fault_flags (sticky). */
+/* Bits of pyins_output.fault_flags (sticky: set once, never cleared). */
 enum pyins_fault_flag {
     PYINS_FAULT_KF_NOT_PD = 1,    /* the fine-alignment covariance lost positive definiteness */
-    PYINS_FAULT_ALIGN_RESTARTED = 2 /* a sample was rejected during alignment, which restarted */
+    PYINS_FAULT_ALIGN_RESTARTED = 2, /* a sample was rejected or missing during alignment, which restarted */
+    PYINS_FAULT_SAMPLE_NONFINITE = 4, /* a sample with NaN/Inf was rejected (n_nonfinite) */
+    PYINS_FAULT_SAMPLE_SATURATED = 8, /* a sample at/beyond a saturation limit was rejected (n_saturated) */
+    PYINS_FAULT_SEQ_GAP = 16,     /* ticks were missing from the sequence (n_seq_gaps, n_seq_bridged) */
+    PYINS_FAULT_SEQ_REPEAT = 32,  /* a duplicate sample was dropped (n_seq_repeats) */
+    PYINS_FAULT_SEQ_LOST = 64,    /* the sequence broke beyond the bridgeable gap (n_seq_lost) */
+    PYINS_FAULT_ENCODER_JUMP = 128 /* the encoder jumped (n_encoder_jumps) */
+};
+
+/* Sequence checking (pyins_config.seq_mode). */
+enum pyins_seq_mode {
+    PYINS_SEQ_OFF = 0,            /* pyins_sample.seq is ignored: every sample is the next tick (old logs) */
+    PYINS_SEQ_CHECK = 1           /* seq must count up by one per tick (wrapping at 2^32) */
 };
 
 /* Firmware modes, in pyins_output.mode. */
@@ -174,6 +200,11 @@ typedef struct pyins_config {
     double index_tolerance_rad;   /* encoder vs command tolerance; 0 = 0.5 deg */
     double index_jump_rad;        /* largest believable encoder change per tick; 0 = 5 deg */
     pyins_index_step index_steps[8]; /* custom scheme */
+    /* Sample-level faults (docs/core.md, "Sample-level faults"). */
+    int32_t seq_mode;             /* enum pyins_seq_mode; 0 = off */
+    int32_t seq_max_gap_ticks;    /* longest gap bridged [ticks], 1..100; 0 = 2 */
+    double sat_gyro_rad;          /* angle increment saturation per axis per tick [rad]; 0 = 400 deg/s x tick */
+    double sat_accel_mps;         /* velocity increment saturation per axis per tick [m/s]; 0 = 20 g x tick */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -181,11 +212,13 @@ typedef struct pyins_sample {
     double dtheta_p_rad[3];       /* angle increment in p [rad] */
     double dv_p_mps[3];           /* velocity increment in p [m/s] */
     double table_angle_rad;       /* encoder angle alpha at t_k, wrapped to [0, 2 pi) [rad] */
+    uint32_t seq;                 /* the IMU's sample counter, +1 per tick, wrapping; read only with PYINS_SEQ_CHECK */
+    uint32_t reserved;            /* ignored; keep 0 */
 } pyins_sample;
 
 /* One output record per step, the state at t_k. */
 typedef struct pyins_output {
-    int64_t tick;                 /* number of samples accepted since init */
+    int64_t tick;                 /* ticks since init: samples taken plus ticks a seq gap skipped */
     int32_t mode;                 /* enum pyins_mode */
     uint32_t fault_flags;         /* bit field, 0 = healthy */
     uint32_t state_flags;         /* enum pyins_state_flag bits */
@@ -212,6 +245,16 @@ typedef struct pyins_output {
     double table_angle_cmd_rad;   /* commanded (unwrapped) table angle */
     double index_a_c;             /* seed 002's cos accumulator A_c */
     double index_a_s;             /* seed 002's sin accumulator A_s */
+    /* Sample-level fault counters since init (saturating at 2^32 - 1), one
+     * per pyins_fault_flag bit of the same name. */
+    uint32_t n_nonfinite;         /* samples rejected for NaN/Inf */
+    uint32_t n_saturated;         /* samples rejected at/beyond a saturation limit */
+    uint32_t n_seq_gaps;          /* gaps of 1..seq_max_gap_ticks missing ticks */
+    uint32_t n_seq_bridged;       /* missing ticks bridged by interpolation (navigation) */
+    uint32_t n_seq_repeats;       /* duplicate samples dropped */
+    uint32_t n_seq_lost;          /* sequence breaks beyond the bridgeable gap */
+    uint32_t n_encoder_jumps;     /* encoder jumps */
+    uint32_t seq;                 /* seq of the last sample taken (0 before any) */
 } pyins_output;
 
 /* The firmware instance. Opaque: it lives in caller memory of
@@ -248,26 +291,34 @@ int pyins_config_check(const pyins_config *cfg);
 int pyins_init(void *mem, size_t mem_size, const pyins_config *cfg);
 
 /* Advance one tick with one sample and write the output record to *out.
- * A rejected sample (PYINS_E_SAMPLE_NONFINITE) leaves the state unchanged;
- * *out then holds the unchanged state.
- * Returns PYINS_OK or a negative pyins_status. */
+ * A rejected sample (PYINS_E_SAMPLE_NONFINITE, PYINS_E_SAMPLE_SATURATED)
+ * leaves the navigation state unchanged (only the fault bits and counters
+ * record it); *out then holds that state. With PYINS_SEQ_CHECK a sample may
+ * also stand for missing ticks (bridged first) or be a dropped duplicate.
+ * Returns PYINS_OK, a positive PYINS_W_* notice (the first that applies of
+ * SEQ_REPEAT, SEQ_LOST, SEQ_GAP, ENCODER_JUMP), or a negative pyins_status. */
 int pyins_step(pyins_core *core, const pyins_sample *sample, pyins_output *out);
 
 /* Step n samples from an array in one call, writing n output records
- * (outputs may be NULL when only the final state is wanted). Stops at the
- * first rejected sample; *n_done (if not NULL) receives the number of samples
- * accepted, so samples[*n_done] is the one rejected. N single steps and one
- * N-sample call give bit-identical outputs.
+ * (outputs may be NULL when only the final state is wanted). Goes on through
+ * PYINS_W_* notices (see the records' fault bits and counters) and stops at
+ * the first rejected sample; *n_done (if not NULL) receives the number of
+ * samples handled, so samples[*n_done] is the one rejected. N single steps
+ * and one N-sample call give bit-identical outputs.
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_run(pyins_core *core, const pyins_sample *samples, size_t n,
               pyins_output *outputs, size_t *n_done);
 
 /* As pyins_run, but write an output record only after the steps whose tick
- * (pyins_output.tick, counted since init) is a multiple of out_every: with
- * out_every = 100 at 100 Hz, one record per second of ship time, in phase
- * whatever the chunking. outputs must hold out_capacity records; at most
- * n / out_every + 1 are written, and a smaller capacity is refused up front
- * (nothing stepped). *n_out (if not NULL) receives the number written.
+ * (pyins_output.tick, counted since init) reaches a multiple of out_every:
+ * with out_every = 100 at 100 Hz, one record per second of ship time, in
+ * phase whatever the chunking. A step that bridges missing ticks past a
+ * multiple writes its record (its tick is then past the multiple).
+ * outputs must hold out_capacity records; a capacity below n / out_every + 1
+ * is refused up front (nothing stepped); bridged gaps can ask for more, and
+ * the call then stops with PYINS_E_BUFFER_TOO_SMALL before the step that
+ * would overflow (*n_done says where to go on). *n_out (if not NULL)
+ * receives the number written.
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
                         size_t out_every, pyins_output *outputs, size_t out_capacity,

@@ -132,9 +132,12 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
             enc = table->encoder_lsb_rad * std::floor(enc / table->encoder_lsb_rad);
         }
         sample.table_angle_rad = enc;
+        // the IMU's packet counter: the number of the tick the sample ends
+        sample.seq = static_cast<uint32_t>(st->tick);
+        sample.reserved = 0u;
 
         const int status = pyins_step(core, &sample, &out);
-        if (status != PYINS_OK) {
+        if (status < 0) {  // rejected; notices (e.g. an encoder jump) go on
             return status;
         }
         st->rate_cmd_rad_s = out.motor_rate_cmd_rad_s;

@@ -82,7 +82,9 @@ typedef struct pyins_plant_record {
  * (n x 3, may be NULL) are added per tick [rad, m/s]. After every tick whose
  * number (st->tick after it) is a multiple of every, the firmware's output
  * and the plant record are written (capacity must hold n / every + 1).
- * Stops at the first tick the firmware rejects; *n_done ticks were run.
+ * Each sample's seq is the tick number it ends (st->tick after it, modulo
+ * 2^32). Stops at the first tick the firmware rejects (a PYINS_W_* notice
+ * does not stop it); *n_done ticks were run.
  * Returns PYINS_OK or the firmware's / a negative pyins_status. */
 int pyins_fil_run(pyins_core *core, pyins_plant_state *st, const pyins_table_config *table,
                   const pyins_imu_errors *err, const double *node_omega_b, const double *node_force_b,

@@ -14,7 +14,8 @@
 
 using pyins::firmware::Firmware;
 
-static_assert(sizeof(pyins_sample) == 7 * sizeof(double), "pyins_sample layout");
+static_assert(sizeof(pyins_sample) == 8 * sizeof(double), "pyins_sample layout");
+static_assert(sizeof(pyins_output) % 8 == 0, "pyins_output layout: arrays of records stay aligned");
 static_assert(alignof(Firmware) <= 16, "instance alignment");
 
 namespace {
@@ -40,7 +41,7 @@ int checked(const pyins_core* core, const Firmware** fw) {
 }
 
 constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
-constexpr uint32_t kSnapFormat = 1u;
+constexpr uint32_t kSnapFormat = 2u;  // 2: sample-level fault state (seq, counters)
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
@@ -113,6 +114,9 @@ int pyins_init(void* mem, size_t mem_size, const pyins_config* cfg) {
     if (status != PYINS_OK) {
         return status;
     }
+    // Every byte of the instance defined, padding included: a snapshot blob
+    // (and its CRC-32) is then a function of the state alone.
+    memset(mem, 0, sizeof(Firmware));
     Firmware* fw = new (mem) Firmware;  // placement new: no allocation
     fw->init(*cfg);
     return PYINS_OK;
@@ -146,7 +150,7 @@ int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
     Firmware* fw = const_cast<Firmware*>(cfw);
     for (size_t i = 0; i < n; ++i) {
         const int s = fw->step(samples[i], outputs != nullptr ? &outputs[i] : nullptr);
-        if (s != PYINS_OK) {
+        if (s < 0) {  // rejected; PYINS_W_* notices go on (the records carry them)
             return s;
         }
         if (n_done != nullptr) {
@@ -182,15 +186,25 @@ int pyins_run_decimated(pyins_core* core, const pyins_sample* samples, size_t n,
     Firmware* fw = const_cast<Firmware*>(cfw);
     const uint64_t every = static_cast<uint64_t>(out_every);
     size_t written = 0;
+    // the next multiple of out_every after the current tick
+    uint64_t next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
     for (size_t i = 0; i < n; ++i) {
+        if (written == out_capacity &&
+            static_cast<uint64_t>(fw->tick() + fw->ticks_for(samples[i])) >= next) {
+            // seq gaps passed more multiples than n / out_every + 1: stop
+            // before the step whose record has no room
+            return PYINS_E_BUFFER_TOO_SMALL;
+        }
         const int s = fw->step(samples[i], nullptr);
-        if (s != PYINS_OK) {
+        if (s < 0) {
             return s;
         }
         if (n_done != nullptr) {
             *n_done = i + 1u;
         }
-        if (static_cast<uint64_t>(fw->tick()) % every == 0u) {
+        // a multiple of out_every reached (or passed by a bridged gap)
+        if (static_cast<uint64_t>(fw->tick()) >= next) {
+            next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
             fw->output(&outputs[written]);
             written = written + 1u;
             if (n_out != nullptr) {
@@ -317,6 +331,13 @@ const char* pyins_status_str(int status) {
         case PYINS_E_SNAPSHOT_VERSION: return "PYINS_E_SNAPSHOT_VERSION: snapshot of another format or ABI version";
         case PYINS_E_SNAPSHOT_CORRUPT: return "PYINS_E_SNAPSHOT_CORRUPT: snapshot magic or checksum wrong";
         case PYINS_E_CONFIG_ALIGN_TICKS: return "PYINS_E_CONFIG_ALIGN_TICKS: an alignment duration is negative, or the first output comes after its end";
+        case PYINS_E_SAMPLE_SATURATED: return "PYINS_E_SAMPLE_SATURATED: an increment is at or beyond its saturation limit; sample rejected, state unchanged";
+        case PYINS_E_CONFIG_SATURATION: return "PYINS_E_CONFIG_SATURATION: saturation limits must be positive and finite (0 = default 400 deg/s, 20 g per tick)";
+        case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
+        case PYINS_W_SEQ_GAP: return "PYINS_W_SEQ_GAP: ticks missing before this sample: bridged (navigation) or alignment restarted; sample taken";
+        case PYINS_W_SEQ_REPEAT: return "PYINS_W_SEQ_REPEAT: a sample already taken (seq repeated or behind): dropped, state unchanged";
+        case PYINS_W_SEQ_LOST: return "PYINS_W_SEQ_LOST: seq jumped beyond the bridgeable gap: sample taken without bridging, sequence resynchronised";
+        case PYINS_W_ENCODER_JUMP: return "PYINS_W_ENCODER_JUMP: the encoder changed by more than index_jump_rad per tick; sample taken";
         default: return "unknown pyins status code";
     }
 }

@@ -49,6 +49,19 @@ inline constexpr double kDefaultIndexJump = 5.0 * kDeg;
 inline constexpr int32_t kDefaultIndexTimeoutS = 2;
 inline constexpr int32_t kDefaultStopSeed003S = 60;
 inline constexpr int32_t kDefaultStopS = 300;
+/// Sample-level faults (docs/core.md). Saturation defaults: 400 deg/s and
+/// 20 g per axis, the order of a navigation-grade RLG IMU's range (the
+/// issue's figures); a ship stays far below (seed 000's bad sea state peaks
+/// at 23 deg/s and 0.3 g beyond gravity), so only a saturated sensor (a
+/// shock) or a corrupted word reaches them.
+inline constexpr double kDefaultSatGyroRate = 400.0 * kDeg;      ///< [rad/s]
+inline constexpr double kDefaultSatAccel = 20.0 * 9.80665;       ///< [m/s^2]
+/// Longest gap bridged by interpolation [ticks]; see docs/core.md for the
+/// error it leaves on seed 000's bad sea state.
+inline constexpr int32_t kDefaultSeqMaxGap = 2;
+/// Upper bound of seq_max_gap_ticks: one step call bridges at most this many
+/// ticks (its worst-case run time is that many strapdown updates).
+inline constexpr int32_t kMaxSeqGap = 100;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -61,14 +74,40 @@ int config_check(const pyins_config& cfg);
 /// The configuration with every zero-means-default field resolved.
 pyins_config config_resolved(const pyins_config& cfg);
 
+/// Sample-level fault counters (pyins_output.n_*), saturating at 2^32 - 1.
+struct SampleCounts {
+    uint32_t nonfinite;
+    uint32_t saturated;
+    uint32_t seq_gaps;
+    uint32_t seq_bridged;
+    uint32_t seq_repeats;
+    uint32_t seq_lost;
+    uint32_t encoder_jumps;
+};
+
+/// How a sample's seq follows the last one taken (PYINS_SEQ_CHECK).
+enum class SeqKind : int32_t { kNext = 0, kGap = 1, kRepeat = 2, kLost = 3 };
+struct SeqStep {
+    SeqKind kind;
+    uint32_t missing;   ///< ticks missing before the sample (kGap, forward kLost)
+};
+
 class Firmware {
   public:
     /// Precondition: config_check(cfg) == PYINS_OK.
     void init(const pyins_config& cfg);
 
-    /// One tick. Rejects a non-finite sample and leaves the state unchanged.
+    /// One sample (docs/core.md, "Sample-level faults"): rejects a
+    /// non-finite or saturated sample (state unchanged but for the fault
+    /// bits and counters); with seq checking, drops a duplicate, bridges a
+    /// short gap before taking the sample, resynchronises after a long one.
     /// Always fills *out (when not null) with the state after the call.
+    /// Returns PYINS_OK, a PYINS_W_* notice or a negative status.
     int step(const pyins_sample& sample, pyins_output* out);
+
+    /// How many ticks stepping this sample would add to tick() (0: it would
+    /// be rejected or dropped). Changes nothing.
+    int64_t ticks_for(const pyins_sample& sample) const;
 
     /// The current state as an output record.
     void output(pyins_output* out) const;
@@ -82,6 +121,19 @@ class Firmware {
     int64_t tick() const { return tick_; }
 
   private:
+    /// Classify a sample's seq against the last one taken.
+    SeqStep seq_step(uint32_t seq) const;
+    /// Finite and within the saturation limits.
+    bool usable(const pyins_sample& sample) const;
+    /// Advance one tick with increments taken as good: encoder unwrap, mode
+    /// machine, alignment or navigation, indexing; tick + 1.
+    void advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
+    /// Bridge `missing` ticks before the sample (dtheta_p, dv_p, encoder):
+    /// increments interpolated linearly between the last sample taken and
+    /// this one, the encoder along the shortest turn between their readings.
+    void bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
+    /// A rejected sample: sticky bit, counter, and an alignment restart.
+    void reject(uint32_t fault_bit, uint32_t* counter);
     /// Leave coarse alignment for fine alignment or navigation.
     void end_coarse();
     /// Start / leave fine alignment.
@@ -119,6 +171,11 @@ class Firmware {
     double encoder_;              ///< last encoder reading, in [0, 2 pi) [rad]
     double enc_sin_half_;         ///< sin(encoder_ / 2), kept with encoder_
     double enc_cos_half_;         ///< cos(encoder_ / 2)
+    uint32_t seq_;                ///< seq of the last sample taken
+    bool seq_valid_;              ///< a sample has been taken since init
+    Vec3 last_dtheta_;            ///< increments of the last sample taken [rad]
+    Vec3 last_dv_;                ///< [m/s]
+    SampleCounts counts_;
 };
 
 }  // namespace pyins::firmware

@@ -3,6 +3,10 @@
 Mirrors ``csrc/src/firmware.{hpp,cpp}`` (and the status codes of
 ``csrc/include/pyins_core.h``). Configurations, samples and outputs use the
 C structs' field names, so a record from either engine reads the same.
+Sample-level faults (NaN/Inf, saturation, seq gaps, duplicates, lost
+sequences, encoder jumps) follow docs/core.md, "Sample-level faults":
+``step(..., seq)`` returns the same statuses (negative: rejected, positive:
+a notice) and the record carries the same bits and counters.
 """
 import math
 
@@ -37,6 +41,16 @@ PYINS_E_CONFIG_INDEX_EMPTY = -24
 PYINS_E_CONFIG_INDEX_RATE = -25
 PYINS_E_CONFIG_INDEX_DELTA = -26
 PYINS_E_CONFIG_INDEX_STEP = -27
+PYINS_E_SNAPSHOT_SIZE = -28
+PYINS_E_SNAPSHOT_VERSION = -29
+PYINS_E_SNAPSHOT_CORRUPT = -30
+PYINS_E_SAMPLE_SATURATED = -31
+PYINS_E_CONFIG_SATURATION = -32
+PYINS_E_CONFIG_SEQ = -33
+PYINS_W_SEQ_GAP = 1          #: notices: the sample was handled (docs/core.md)
+PYINS_W_SEQ_REPEAT = 2
+PYINS_W_SEQ_LOST = 3
+PYINS_W_ENCODER_JUMP = 4
 
 INDEX_NONE, INDEX_SINGLE_FWD_REV, INDEX_TWO_POSITION, INDEX_FOUR_POSITION = 0, 1, 2, 3
 INDEX_FLEXIBLE_TWO, INDEX_CUSTOM, INDEX_FLEXIBLE_DERIVED = 4, 5, 6
@@ -45,6 +59,17 @@ FINE_FEEDBACK = 0      #: PYINS_FINE_FEEDBACK
 FINE_OPEN_LOOP = 1     #: PYINS_FINE_OPEN_LOOP
 FAULT_KF_NOT_PD = 1    #: PYINS_FAULT_KF_NOT_PD
 FAULT_ALIGN_RESTARTED = 2  #: PYINS_FAULT_ALIGN_RESTARTED
+FAULT_SAMPLE_NONFINITE = 4   #: PYINS_FAULT_SAMPLE_NONFINITE
+FAULT_SAMPLE_SATURATED = 8   #: PYINS_FAULT_SAMPLE_SATURATED
+FAULT_SEQ_GAP = 16           #: PYINS_FAULT_SEQ_GAP
+FAULT_SEQ_REPEAT = 32        #: PYINS_FAULT_SEQ_REPEAT
+FAULT_SEQ_LOST = 64          #: PYINS_FAULT_SEQ_LOST
+FAULT_ENCODER_JUMP = 128     #: PYINS_FAULT_ENCODER_JUMP
+
+SEQ_OFF = 0                  #: PYINS_SEQ_OFF
+SEQ_CHECK = 1                #: PYINS_SEQ_CHECK
+SEQ_NEXT, SEQ_GAP, SEQ_REPEAT, SEQ_LOST = 0, 1, 2, 3   #: SeqKind
+U32 = 0xFFFFFFFF
 
 MODE_IDLE = 0          #: Mode::kIdle
 MODE_COARSE_ALIGN = 1  #: Mode::kCoarseAlign
@@ -74,6 +99,12 @@ DEFAULT_INDEX_JUMP = 5.0 * DEG          #: kDefaultIndexJump
 DEFAULT_INDEX_TIMEOUT_S = 2             #: kDefaultIndexTimeoutS
 DEFAULT_STOP_SEED003_S = 60             #: kDefaultStopSeed003S
 DEFAULT_STOP_S = 300                    #: kDefaultStopS
+DEFAULT_SAT_GYRO_RATE = 400.0 * DEG     #: kDefaultSatGyroRate [rad/s]
+DEFAULT_SAT_ACCEL = 20.0 * 9.80665      #: kDefaultSatAccel [m/s^2]
+DEFAULT_SEQ_MAX_GAP = 2                 #: kDefaultSeqMaxGap [ticks]
+MAX_SEQ_GAP = 100                       #: kMaxSeqGap [ticks]
+COUNTERS = ("n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_repeats",
+            "n_seq_lost", "n_encoder_jumps")   #: SampleCounts, as named in pyins_output
 
 DEFAULT_TICK_HZ = 100          #: kDefaultTickHz
 MAX_TICK_HZ = 10000            #: kMaxTickHz
@@ -118,6 +149,10 @@ def config_default():
         "index_tolerance_rad": 0.0,
         "index_jump_rad": 0.0,
         "index_steps": [],    # list of (stop_ticks, kind, angle_rad)
+        "seq_mode": SEQ_OFF,
+        "seq_max_gap_ticks": 0,
+        "sat_gyro_rad": 0.0,
+        "sat_accel_mps": 0.0,
     }
 
 
@@ -167,6 +202,12 @@ def config_resolved(cfg):
         cfg["index_jump_rad"] = DEFAULT_INDEX_JUMP
     if cfg["index_timeout_ticks"] == 0:
         cfg["index_timeout_ticks"] = DEFAULT_INDEX_TIMEOUT_S * cfg["tick_hz"]
+    if cfg["seq_max_gap_ticks"] == 0:
+        cfg["seq_max_gap_ticks"] = DEFAULT_SEQ_MAX_GAP
+    if cfg["sat_gyro_rad"] == 0.0:
+        cfg["sat_gyro_rad"] = DEFAULT_SAT_GYRO_RATE / float(cfg["tick_hz"])
+    if cfg["sat_accel_mps"] == 0.0:
+        cfg["sat_accel_mps"] = DEFAULT_SAT_ACCEL / float(cfg["tick_hz"])
     return cfg
 
 
@@ -245,15 +286,24 @@ def config_check(raw):
     for v in noise:
         if not (v > 0.0) or not math.isfinite(v):
             return PYINS_E_CONFIG_NOISE
-    return index_check(cfg)
+    index_status = index_check(cfg)
+    if index_status != PYINS_OK:
+        return index_status
+    if cfg["seq_mode"] not in (SEQ_OFF, SEQ_CHECK) or not 1 <= cfg["seq_max_gap_ticks"] <= MAX_SEQ_GAP:
+        return PYINS_E_CONFIG_SEQ
+    sat = (cfg["sat_gyro_rad"], cfg["sat_accel_mps"])
+    if any(not (v > 0.0) or not math.isfinite(v) for v in sat):
+        return PYINS_E_CONFIG_SATURATION
+    return PYINS_OK
 
 
 def wrap_two_pi(a):
-    """Angle in [0, 2 pi)."""
+    """Angle in [0, 2 pi) for any finite input (mirrors wrap_two_pi: a
+    rounding to 2 pi or below 0, or a too large to wrap, gives 0)."""
     if 0.0 <= a < TWO_PI:
         return a
     w = a - TWO_PI * math.floor(a / TWO_PI)
-    if w >= TWO_PI:
+    if not (0.0 <= w < TWO_PI):
         w = 0.0
     return w
 
@@ -265,6 +315,16 @@ def wrap_pi(a):
     if a <= -np.pi:
         return a + TWO_PI
     return a
+
+
+def saturated3(v, limit):
+    """Some component at or beyond the limit (mirrors saturated3)."""
+    return abs(v[0]) >= limit or abs(v[1]) >= limit or abs(v[2]) >= limit
+
+
+def count(counter, n=1):
+    """counter + n, saturating at 2^32 - 1 (mirrors count)."""
+    return U32 if n > U32 - counter else counter + n
 
 
 class Firmware:
@@ -300,6 +360,11 @@ class Firmware:
         self.encoder = wrap_two_pi(cfg["table_angle_rad"])
         self.enc_sin_half = math.sin(0.5 * self.encoder)
         self.enc_cos_half = math.cos(0.5 * self.encoder)
+        self.seq = 0
+        self.seq_valid = False
+        self.last_dtheta = np.zeros(3)
+        self.last_dv = np.zeros(3)
+        self.counts = dict.fromkeys(COUNTERS, 0)
         euler_b = np.array(cfg["euler_b_rad"], dtype=float)
         mat_np = attitude.euler_to_mat(euler_b) @ attitude.rot_z(self.encoder)
         lon = cfg["lon_rad"]
@@ -395,16 +460,109 @@ class Firmware:
         self.sd.nav.vel_n = np.zeros(3)
         self.sd.prev_dvel_n = np.zeros(3)
 
-    def step(self, dtheta_p, dv_p, table_angle_rad):
-        """One tick; returns ``(status, output dict)``."""
+    def reject(self, fault_bit, counter):
+        """A rejected sample: sticky bit, counter, alignment restart (mirrors reject)."""
+        self.faults = self.faults | fault_bit
+        self.counts[counter] = count(self.counts[counter])
+        if self.mode in (MODE_COARSE_ALIGN, MODE_FINE_ALIGN):
+            self.gap_pending = True
+            self.faults = self.faults | FAULT_ALIGN_RESTARTED
+
+    def seq_step(self, seq):
+        """(kind, missing ticks) of a sample's seq (mirrors Firmware::seq_step)."""
+        if self.cfg["seq_mode"] != SEQ_CHECK or not self.seq_valid:
+            return SEQ_NEXT, 0
+        d = (seq - self.seq) & U32
+        g = self.cfg["seq_max_gap_ticks"]
+        if d == 0 or d >= ((0 - g) & U32):
+            return SEQ_REPEAT, 0
+        if d > g + 1:
+            return SEQ_LOST, (d - 1 if d < 0x80000000 else 0)
+        if d > 1:
+            return SEQ_GAP, d - 1
+        return SEQ_NEXT, 0
+
+    def usable(self, dtheta_p, dv_p, table_angle_rad):
+        """Finite and within the saturation limits (mirrors Firmware::usable)."""
+        return (_finite3(dtheta_p) and _finite3(dv_p) and math.isfinite(table_angle_rad)
+                and not saturated3(dtheta_p, self.cfg["sat_gyro_rad"])
+                and not saturated3(dv_p, self.cfg["sat_accel_mps"]))
+
+    def ticks_for(self, dtheta_p, dv_p, table_angle_rad, seq=0):
+        """Ticks stepping this sample would add (0: rejected or dropped); changes nothing."""
+        if not self.usable(dtheta_p, dv_p, table_angle_rad):
+            return 0
+        kind, missing = self.seq_step(int(seq) & U32)
+        return 0 if kind == SEQ_REPEAT else missing + 1
+
+    def step(self, dtheta_p, dv_p, table_angle_rad, seq=0):
+        """One sample; returns ``(status, output dict)`` (mirrors Firmware::step).
+
+        ``seq`` is the IMU's sample counter (read with ``seq_mode`` = SEQ_CHECK).
+        """
         if not (_finite3(dtheta_p) and _finite3(dv_p) and math.isfinite(table_angle_rad)):
+            self.reject(FAULT_SAMPLE_NONFINITE, "n_nonfinite")
+            return PYINS_E_SAMPLE_NONFINITE, self.output()
+        if saturated3(dtheta_p, self.cfg["sat_gyro_rad"]) or saturated3(dv_p, self.cfg["sat_accel_mps"]):
+            self.reject(FAULT_SAMPLE_SATURATED, "n_saturated")
+            return PYINS_E_SAMPLE_SATURATED, self.output()
+        seq = int(seq) & U32
+        status = PYINS_OK
+        kind, missing = self.seq_step(seq)
+        if kind == SEQ_REPEAT:
+            self.faults = self.faults | FAULT_SEQ_REPEAT
+            self.counts["n_seq_repeats"] = count(self.counts["n_seq_repeats"])
+            return PYINS_W_SEQ_REPEAT, self.output()
+        resync = kind == SEQ_LOST
+        if resync:
+            self.faults = self.faults | FAULT_SEQ_LOST
+            self.counts["n_seq_lost"] = count(self.counts["n_seq_lost"])
+            status = PYINS_W_SEQ_LOST
+        elif kind == SEQ_GAP:
+            self.faults = self.faults | FAULT_SEQ_GAP
+            self.counts["n_seq_gaps"] = count(self.counts["n_seq_gaps"])
+            status = PYINS_W_SEQ_GAP
+        dtheta_p = np.array(dtheta_p, dtype=float)
+        dv_p = np.array(dv_p, dtype=float)
+        encoder = wrap_two_pi(table_angle_rad)
+        if (self.mode != MODE_IDLE and not resync
+                and abs(wrap_pi(encoder - self.encoder)) > self.cfg["index_jump_rad"] * float(missing + 1)):
+            self.faults = self.faults | FAULT_ENCODER_JUMP
+            self.counts["n_encoder_jumps"] = count(self.counts["n_encoder_jumps"])
+            if status == PYINS_OK:
+                status = PYINS_W_ENCODER_JUMP
+        if missing > 0 or resync:
             if self.mode in (MODE_COARSE_ALIGN, MODE_FINE_ALIGN):
                 self.gap_pending = True
                 self.faults = self.faults | FAULT_ALIGN_RESTARTED
-            return PYINS_E_SAMPLE_NONFINITE, self.output()
-        dtheta_p = np.asarray(dtheta_p, dtype=float)
-        dv_p = np.asarray(dv_p, dtype=float)
-        encoder = wrap_two_pi(table_angle_rad)
+                self.tick = self.tick + missing
+            elif resync:
+                self.tick = self.tick + missing
+            else:
+                self.bridge(missing, dtheta_p, dv_p, encoder)
+                self.counts["n_seq_bridged"] = count(self.counts["n_seq_bridged"], missing)
+        self.advance(dtheta_p, dv_p, encoder)
+        self.last_dtheta = dtheta_p.copy()
+        self.last_dv = dv_p.copy()
+        self.seq = seq
+        self.seq_valid = True
+        return status, self.output()
+
+    def bridge(self, missing, dtheta_p, dv_p, encoder):
+        """Interpolate the missing ticks between the last sample and this one (mirrors bridge)."""
+        dtheta0 = self.last_dtheta
+        dv0 = self.last_dv
+        ddtheta = dtheta_p - dtheta0
+        ddv = dv_p - dv0
+        enc0 = self.encoder
+        turn = wrap_pi(encoder - enc0)
+        span = float(missing + 1)
+        for j in range(1, missing + 1):
+            f = float(j) / span
+            self.advance(dtheta0 + ddtheta * f, dv0 + ddv * f, wrap_two_pi(enc0 + turn * f))
+
+    def advance(self, dtheta_p, dv_p, encoder):
+        """One tick with increments taken as good (mirrors Firmware::advance)."""
         self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
         if encoder != self.encoder:   # the table moved: refresh the cached half-angle
             self.encoder = encoder
@@ -446,7 +604,6 @@ class Firmware:
             if self.index_prm.n_steps > 0:
                 indexing.update(self.idx, self.table_angle, self.imu_yaw())
         self.tick = self.tick + 1
-        return PYINS_OK, self.output()
 
     def output(self):
         nav = self.sd.nav
@@ -486,6 +643,8 @@ class Firmware:
             "index_a_s": self.idx.a_s,
             "kf_states": self.kf_states,
             "align_restarts": self.align_restarts,
+            **self.counts,
+            "seq": self.seq,
             "kf_x": self._kf(lambda f: f.x),
             "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
         }
@@ -497,12 +656,12 @@ class Firmware:
             out[:len(v)] = v
         return out
 
-    def run(self, dtheta_p, dv_p, table_angle_rad):
-        """Step through arrays; returns a list of output dicts (stops at a rejected sample)."""
+    def run(self, dtheta_p, dv_p, table_angle_rad, seq=None):
+        """Step through arrays; returns a list of output dicts (raises at a rejected sample)."""
         outs = []
         for k in range(len(dtheta_p)):
-            status, out = self.step(dtheta_p[k], dv_p[k], table_angle_rad[k])
-            if status != PYINS_OK:
+            status, out = self.step(dtheta_p[k], dv_p[k], table_angle_rad[k], 0 if seq is None else seq[k])
+            if status < 0:
                 raise ValueError(f"sample {k} rejected with status {status}")
             outs.append(out)
         return outs

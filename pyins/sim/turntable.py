@@ -68,8 +68,10 @@ def wrap_two_pi(a):
 
 
 def plant_tick(cfg, st, errors, omega_b, force_b, x, w, gyro_noise, accel_noise, dt):
-    """One tick of the plant: returns (dtheta_p, dv_p, encoder) for the
-    firmware, advancing st. omega_b, force_b: (nodes, 3) ship rates."""
+    """One tick of the plant: returns (dtheta_p, dv_p, encoder, seq) for the
+    firmware, advancing st; seq is the IMU's packet counter, the number of the
+    tick the sample ends modulo 2^32 (as plant.cpp fills pyins_sample.seq).
+    omega_b, force_b: (nodes, 3) ship rates."""
     half = 0.5 * dt
     a = table_accel(cfg, st, dt)
     dtheta = np.zeros(3)
@@ -98,7 +100,7 @@ def plant_tick(cfg, st, errors, omega_b, force_b, x, w, gyro_noise, accel_noise,
     enc = wrap_two_pi(enc)
     if cfg.encoder_lsb_rad > 0.0:
         enc = cfg.encoder_lsb_rad * np.floor(enc / cfg.encoder_lsb_rad)
-    return gyro, accel, enc
+    return gyro, accel, enc, st.tick & 0xFFFFFFFF
 
 
 def error_matrices(sensor_errors):

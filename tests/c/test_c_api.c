@@ -1,7 +1,9 @@
 /* test_c_api.c: C99 test of the pyins C ABI contract: every status code,
- * rejected samples leave the state unchanged, determinism, run == steps.
+ * rejected samples leave the state unchanged, sample-level faults (each
+ * status, bit and counter), determinism, run == steps.
  * Prints one line per check and a closing "N passed, M failed" line. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,6 +47,23 @@ static pyins_sample static_sample(void) {
     return s;
 }
 
+/* Equal but for the sample-level fault bookkeeping (bits and counters). */
+static int same_state(const pyins_output *a, const pyins_output *b) {
+    pyins_output x = *a, y = *b;
+    x.fault_flags = y.fault_flags = 0u;
+    x.n_nonfinite = y.n_nonfinite = 0u;
+    x.n_saturated = y.n_saturated = 0u;
+    x.n_seq_gaps = y.n_seq_gaps = 0u;
+    x.n_seq_bridged = y.n_seq_bridged = 0u;
+    x.n_seq_repeats = y.n_seq_repeats = 0u;
+    x.n_seq_lost = y.n_seq_lost = 0u;
+    x.n_encoder_jumps = y.n_encoder_jumps = 0u;
+    x.seq = y.seq = 0u;
+    return memcmp(&x, &y, sizeof x) == 0;
+}
+
+static void sample_faults(unsigned char *mem, unsigned char *mem2, size_t size);
+
 int main(void) {
     const size_t size = pyins_core_size();
     const size_t align = pyins_core_align();
@@ -74,7 +93,9 @@ int main(void) {
                              PYINS_E_CONFIG_INDEX_SCHEME, PYINS_E_CONFIG_INDEX_EMPTY,
                              PYINS_E_CONFIG_INDEX_RATE, PYINS_E_CONFIG_INDEX_DELTA,
                              PYINS_E_CONFIG_INDEX_STEP, PYINS_E_SNAPSHOT_SIZE,
-                             PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT};
+                             PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT,
+                             PYINS_E_SAMPLE_SATURATED, PYINS_E_CONFIG_SATURATION, PYINS_E_CONFIG_SEQ,
+                             PYINS_W_SEQ_GAP, PYINS_W_SEQ_REPEAT, PYINS_W_SEQ_LOST, PYINS_W_ENCODER_JUMP};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
         int distinct = 1;
@@ -92,6 +113,15 @@ int main(void) {
         check(PYINS_E_NULL == -1 && PYINS_E_MISALIGNED == -2 && PYINS_E_MEM_TOO_SMALL == -3 &&
               PYINS_E_NOT_INIT == -4 && PYINS_E_SAMPLE_NONFINITE == -5 && PYINS_E_CONFIG_RATE == -10 &&
               PYINS_E_CONFIG_LAT == -11 && PYINS_E_CONFIG_MODE == -16, "pinned status values");
+        check(PYINS_E_SNAPSHOT_CORRUPT == -30 && PYINS_E_SAMPLE_SATURATED == -31 &&
+              PYINS_E_CONFIG_SATURATION == -32 && PYINS_E_CONFIG_SEQ == -33 && PYINS_W_SEQ_GAP == 1 &&
+              PYINS_W_SEQ_REPEAT == 2 && PYINS_W_SEQ_LOST == 3 && PYINS_W_ENCODER_JUMP == 4,
+              "pinned sample-level status values");
+        check(PYINS_FAULT_SAMPLE_NONFINITE == 4 && PYINS_FAULT_SAMPLE_SATURATED == 8 && PYINS_FAULT_SEQ_GAP == 16 &&
+              PYINS_FAULT_SEQ_REPEAT == 32 && PYINS_FAULT_SEQ_LOST == 64 && PYINS_FAULT_ENCODER_JUMP == 128,
+              "pinned fault bits");
+        check(sizeof(pyins_sample) == 64 && offsetof(pyins_sample, seq) == 56 && sizeof(pyins_output) % 8 == 0,
+              "sample and output layout");
     }
 
     /* Config: defaults, zeroed == defaults, each bad field its own status. */
@@ -164,6 +194,23 @@ int main(void) {
              b.index_steps[0].kind = PYINS_INDEX_FIXED, b.index_steps[0].angle_rad = 3.14,
              b.index_rate_rad_s = 0.1, b.index_accel_rad_s2 = 1.0), PYINS_E_CONFIG_INDEX_STEP,
             "custom step with no stop");
+    BAD_CFG(b.seq_mode = 2, PYINS_E_CONFIG_SEQ, "unknown seq mode");
+    BAD_CFG(b.seq_mode = -1, PYINS_E_CONFIG_SEQ, "negative seq mode");
+    BAD_CFG(b.seq_max_gap_ticks = -1, PYINS_E_CONFIG_SEQ, "negative seq gap");
+    BAD_CFG(b.seq_max_gap_ticks = 101, PYINS_E_CONFIG_SEQ, "seq gap beyond 100 ticks");
+    BAD_CFG(b.sat_gyro_rad = -0.1, PYINS_E_CONFIG_SATURATION, "negative gyro saturation");
+    BAD_CFG(b.sat_gyro_rad = NAN, PYINS_E_CONFIG_SATURATION, "NaN gyro saturation");
+    BAD_CFG(b.sat_accel_mps = INFINITY, PYINS_E_CONFIG_SATURATION, "Inf accel saturation");
+    BAD_CFG(b.sat_accel_mps = -1.0, PYINS_E_CONFIG_SATURATION, "negative accel saturation");
+    {
+        pyins_config g;
+        pyins_config_default(&g);
+        g.seq_mode = PYINS_SEQ_CHECK;
+        g.seq_max_gap_ticks = 100;
+        g.sat_gyro_rad = 1e-9;
+        g.sat_accel_mps = 1e3;
+        check_status(pyins_config_check(&g), PYINS_OK, "seq and saturation limits in range");
+    }
 
     /* init: NULL, misaligned, too small. */
     check_status(pyins_init(NULL, size, &cfg), PYINS_E_NULL, "init NULL mem");
@@ -194,7 +241,8 @@ int main(void) {
         check_status(pyins_step(core, &s, &out), PYINS_OK, "step");
         check(out.tick == 1 && out.mode == PYINS_MODE_NAVIGATE && out.fault_flags == 0u, "tick, mode, faults after one step");
         check_status(pyins_get_output(core, &before), PYINS_OK, "get_output");
-        /* Each non-finite field rejected; state untouched. */
+        /* Each non-finite field rejected; state untouched but for the fault
+         * bit and counter. */
         {
             int f;
             for (f = 0; f < 7; ++f) {
@@ -204,11 +252,13 @@ int main(void) {
                                      &bad.table_angle_rad};
                 *fields[f] = (f % 2) ? NAN : -INFINITY;
                 check_status(pyins_step(core, &bad, &out), PYINS_E_SAMPLE_NONFINITE, "non-finite sample rejected");
-                check(memcmp(&out, &before, sizeof out) == 0, "rejected sample: output shows unchanged state");
+                check(same_state(&out, &before), "rejected sample: output shows unchanged state");
+                check(out.n_nonfinite == (uint32_t)f + 1u && out.fault_flags == PYINS_FAULT_SAMPLE_NONFINITE,
+                      "non-finite sample: bit and counter");
             }
         }
         check_status(pyins_get_output(core, &after), PYINS_OK, "get_output after rejects");
-        check(memcmp(&before, &after, sizeof before) == 0, "rejected samples leave the state unchanged");
+        check(same_state(&before, &after), "rejected samples leave the state unchanged");
 
         /* run stops at a bad sample and says where. */
         {
@@ -322,7 +372,236 @@ int main(void) {
         free(raw2);
     }
 
+    {
+        unsigned char *raw2 = NULL;
+        unsigned char *mem2 = aligned_mem(size, &raw2);
+        sample_faults(mem, mem2, size);
+        free(raw2);
+    }
+
     free(raw);
     printf("%d passed, %d failed\n", n_pass, n_fail);
     return n_fail == 0 ? 0 : 1;
+}
+
+/* Sample-level faults (docs/core.md): each status, its sticky bit and
+ * counter, and the documented behaviour, on a static base at latitude 0
+ * (uniform motion: a bridged gap is exact). */
+static void sample_faults(unsigned char *mem, unsigned char *mem2, size_t size) {
+    pyins_core *core = (pyins_core *)mem;
+    pyins_core *full = (pyins_core *)mem2;
+    pyins_config cfg;
+    pyins_sample s = static_sample();
+    pyins_output out, ref, before;
+    uint32_t k;
+    int i;
+    pyins_config_default(&cfg);
+    cfg.seq_mode = PYINS_SEQ_CHECK;
+    check_status(pyins_init(mem, size, &cfg), PYINS_OK, "faults: init");
+    check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "faults: init reference");
+    for (k = 1; k <= 10; ++k) {
+        s.seq = k;
+        pyins_step(core, &s, &out);
+        pyins_step(full, &s, &ref);
+    }
+    check(out.fault_flags == 0u && out.tick == 10 && out.seq == 10u, "faults: clean start");
+
+    /* Saturation: at the limit rejected, just below taken. */
+    {
+        const double lim = 400.0 * 3.14159265358979323846 / 180.0 / 100.0;   /* default, 100 Hz */
+        pyins_sample bad = s;
+        pyins_get_output(core, &before);
+        bad.seq = 11u;
+        bad.dtheta_p_rad[2] = -lim;
+        check_status(pyins_step(core, &bad, &out), PYINS_E_SAMPLE_SATURATED, "gyro at the saturation limit rejected");
+        check(same_state(&out, &before) && out.n_saturated == 1u && out.fault_flags == PYINS_FAULT_SAMPLE_SATURATED,
+              "saturated: state held, bit and counter");
+        bad = s;
+        bad.seq = 11u;
+        bad.dv_p_mps[0] = 20.0 * 9.80665 / 100.0;
+        check_status(pyins_step(core, &bad, &out), PYINS_E_SAMPLE_SATURATED, "accel at the saturation limit rejected");
+        check(out.n_saturated == 2u && out.tick == 10, "second saturated sample counted, tick held");
+        /* the hole left by the rejected seq 11 is bridged by seq 12: uniform motion, exact */
+        s.seq = 11u;
+        pyins_step(full, &s, &ref);
+        s.seq = 12u;
+        pyins_step(full, &s, &ref);
+        check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_GAP, "sample after a rejected one bridges it");
+        check(out.tick == 12 && out.n_seq_gaps == 1u && out.n_seq_bridged == 1u &&
+              (out.fault_flags & PYINS_FAULT_SEQ_GAP) && same_state(&out, &ref),
+              "bridged rejected sample == full data (uniform motion)");
+        bad = s;
+        bad.seq = 13u;
+        bad.dtheta_p_rad[0] = 0.999 * lim;
+        bad.dv_p_mps[1] = -0.999 * 20.0 * 9.80665 / 100.0;
+        {
+            pyins_output o2;
+            check_status(pyins_step(core, &bad, &o2), PYINS_OK, "just below the saturation limits taken");
+            check(o2.n_saturated == 2u, "no saturation counted below the limit");
+        }
+        /* resynchronise the reference with a fresh pair */
+        check_status(pyins_init(mem, size, &cfg), PYINS_OK, "faults: re-init");
+        check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "faults: re-init reference");
+        s = static_sample();
+        for (k = 1; k <= 10; ++k) {
+            s.seq = k;
+            pyins_step(core, &s, &out);
+            pyins_step(full, &s, &ref);
+        }
+    }
+
+    /* Gap of 2 (the default maximum): bridged, time right, exact on uniform motion. */
+    for (k = 11; k <= 13; ++k) {
+        s.seq = k;
+        pyins_step(full, &s, &ref);
+    }
+    s.seq = 13u;
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_GAP, "gap of 2 ticks");
+    check(out.tick == 13 && out.n_seq_gaps == 1u && out.n_seq_bridged == 2u && out.seq == 13u &&
+          out.fault_flags == PYINS_FAULT_SEQ_GAP, "gap: tick, counters, bit");
+    check(same_state(&out, &ref), "bridged gap == full data (uniform motion)");
+
+    /* Duplicate and a sample up to the maximum gap behind: dropped, state unchanged. */
+    pyins_get_output(core, &before);
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_REPEAT, "repeated seq");
+    check(same_state(&out, &before) && out.n_seq_repeats == 1u && (out.fault_flags & PYINS_FAULT_SEQ_REPEAT),
+          "duplicate dropped: state unchanged, bit and counter");
+    s.seq = 11u;
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_REPEAT, "seq 2 behind: a repeat");
+    check(same_state(&out, &before) && out.n_seq_repeats == 2u && out.seq == 13u, "older sample dropped");
+
+    /* Beyond the maximum gap: taken without bridging, resynchronised. */
+    s.seq = 17u;
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_LOST, "gap of 3 > 2: sequence lost");
+    check(out.tick == 17 && out.n_seq_lost == 1u && out.n_seq_bridged == 2u && out.seq == 17u &&
+          (out.fault_flags & PYINS_FAULT_SEQ_LOST), "lost: time right, nothing bridged, bit and counter");
+    s.seq = 18u;
+    check_status(pyins_step(core, &s, &out), PYINS_OK, "resynchronised: next seq clean");
+    s.seq = 5u;   /* an IMU restart: far behind */
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_LOST, "backward jump beyond the window: lost");
+    check(out.tick == 19 && out.n_seq_lost == 2u, "backward jump: one tick (outage unknown)");
+
+    /* Wrap at 2^32: the next of 0xFFFFFFFF is 0. */
+    s.seq = 0xFFFFFFFFu;
+    pyins_step(core, &s, &out);
+    s.seq = 0u;
+    check_status(pyins_step(core, &s, &out), PYINS_OK, "seq wraps from 2^32 - 1 to 0");
+    s.seq = 2u;
+    check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_GAP, "gap across zero");
+
+    /* Encoder jump: taken, bit and counter. */
+    {
+        pyins_sample j = s;
+        j.seq = 3u;
+        j.table_angle_rad = 0.2;   /* > 5 deg in one tick */
+        check_status(pyins_step(core, &j, &out), PYINS_W_ENCODER_JUMP, "encoder jump");
+        check(out.n_encoder_jumps == 1u && (out.fault_flags & PYINS_FAULT_ENCODER_JUMP) &&
+              fabs(out.table_angle_rad - 0.2) < 1e-15, "encoder jump: reading taken, bit and counter");
+        j.seq = 4u;
+        j.table_angle_rad = 0.2 + 0.08;   /* < 5 deg */
+        check_status(pyins_step(core, &j, &out), PYINS_OK, "encoder change within the limit");
+        j.seq = 6u;
+        j.table_angle_rad = 0.2 + 0.08 + 0.16;   /* < 2 x 5 deg over a gap of one tick */
+        check_status(pyins_step(core, &j, &out), PYINS_W_SEQ_GAP, "encoder change scaled by the gap");
+        check(out.n_encoder_jumps == 1u, "no jump over a bridged gap within the limit");
+    }
+    check(out.fault_flags == (PYINS_FAULT_SEQ_GAP | PYINS_FAULT_SEQ_REPEAT | PYINS_FAULT_SEQ_LOST |
+                              PYINS_FAULT_ENCODER_JUMP), "sticky bits accumulate");
+
+    /* Batch calls go on through notices and stop at a rejected sample. */
+    {
+        pyins_sample batch[6];
+        pyins_output outs[6];
+        size_t n_done = 0;
+        for (i = 0; i < 6; ++i) {
+            batch[i] = s;
+            batch[i].table_angle_rad = out.table_angle_rad;
+            batch[i].seq = 7u + (uint32_t)i;
+        }
+        batch[1].seq = 7u;                 /* duplicate */
+        batch[2].seq = 10u;                /* after 7: 8 and 9 missing */
+        batch[4].dtheta_p_rad[0] = 1.0;    /* saturated */
+        check_status(pyins_run(core, batch, 6, outs, &n_done), PYINS_E_SAMPLE_SATURATED, "run stops at a saturated sample");
+        check(n_done == 4 && outs[1].n_seq_repeats == 3u && outs[2].n_seq_bridged == 2u + 1u + 1u + 2u,
+              "run went on through the duplicate and the gap");
+    }
+
+    /* Decimated runs: a bridged gap passing a multiple writes its record;
+     * more multiples than n / out_every + 1 stop before an overflow. */
+    {
+        pyins_sample batch[8];
+        pyins_output outs[8];
+        size_t n_done = 0, n_out = 0;
+        int64_t t0;
+        pyins_config c2 = cfg;
+        c2.seq_max_gap_ticks = 100;
+        check_status(pyins_init(mem, size, &c2), PYINS_OK, "decimated: init");
+        s = static_sample();
+        for (i = 0; i < 8; ++i) {
+            batch[i] = s;
+            batch[i].seq = 1u + 10u * (uint32_t)i;   /* every sample 10 ticks on */
+        }
+        /* 8 samples, every 10 ticks: capacity 8 / 10 + 1 = 1 suffices without gaps */
+        check_status(pyins_run_decimated(core, batch, 8, 10, outs, 1, &n_done, &n_out),
+                     PYINS_E_BUFFER_TOO_SMALL, "decimated: gaps need more records than the capacity");
+        check(n_done == 2 && n_out == 1 && outs[0].tick == 11, "decimated: stopped before the overflowing step");
+        pyins_get_output(core, &out);
+        t0 = out.tick;
+        check_status(pyins_run_decimated(core, batch + 2, 6, 10, outs, 8, &n_done, &n_out), PYINS_OK,
+                     "decimated: go on with room");
+        check(t0 == 11 && n_done == 6 && n_out == 6 && outs[0].tick == 21 && outs[5].tick == 71,
+              "decimated: one record per multiple passed");
+    }
+
+    /* Seq checking off: seq ignored entirely. */
+    {
+        pyins_config c3;
+        pyins_config_default(&c3);
+        check_status(pyins_init(mem, size, &c3), PYINS_OK, "seq off: init");
+        check_status(pyins_init(mem2, size, &c3), PYINS_OK, "seq off: init reference");
+        s = static_sample();
+        for (k = 0; k < 20; ++k) {
+            s.seq = (k * 2654435761u) ^ 0x5bd1e995u;   /* anything */
+            if (pyins_step(core, &s, &out) != PYINS_OK) break;
+            s.seq = 0u;
+            pyins_step(full, &s, &ref);
+        }
+        check(k == 20 && out.fault_flags == 0u && same_state(&out, &ref), "seq off: any seq is the next tick");
+    }
+
+    /* Absurd but finite angles wrap into range (tests/fuzz found a configured
+     * table angle of -2^755 giving an IMU yaw of -2^755). */
+    {
+        pyins_config c5;
+        pyins_sample w = static_sample();
+        pyins_config_default(&c5);
+        c5.table_angle_rad = -0x1p+755;
+        check_status(pyins_init(mem, size, &c5), PYINS_OK, "huge table angle: init");
+        pyins_step(core, &w, &out);
+        check(out.yaw_p_rad > -3.14159265358979323846 && out.yaw_p_rad <= 3.14159265358979323846,
+              "huge configured table angle: IMU yaw in (-pi, pi]");
+        w.table_angle_rad = 1e300;
+        pyins_step(core, &w, &out);
+        check(out.yaw_p_rad > -3.14159265358979323846 && out.yaw_p_rad <= 3.14159265358979323846,
+              "huge encoder reading: IMU yaw in (-pi, pi]");
+    }
+
+    /* A gap during alignment restarts it (time kept right). */
+    {
+        pyins_config c4;
+        pyins_config_default(&c4);
+        c4.seq_mode = PYINS_SEQ_CHECK;
+        c4.fine_ticks = 100;
+        check_status(pyins_init(mem, size, &c4), PYINS_OK, "alignment gap: init");
+        s = static_sample();
+        for (k = 1; k <= 30; ++k) {
+            s.seq = k;
+            pyins_step(core, &s, &out);
+        }
+        s.seq = 32u;
+        check_status(pyins_step(core, &s, &out), PYINS_W_SEQ_GAP, "gap during fine alignment");
+        check(out.mode == PYINS_MODE_FINE_ALIGN && out.align_restarts == 1 && out.tick == 32 &&
+              out.n_seq_bridged == 0u && (out.fault_flags & PYINS_FAULT_ALIGN_RESTARTED),
+              "alignment restarted at the sample after the gap, nothing bridged");
+    }
 }

@@ -22,7 +22,7 @@ def test_fil_cpp_equals_numpy(scheme):
     errors = sim.preset("seed002")
     errors.gyro_quantum = 1e-7
     errors.accel_quantum = 1e-5
-    cfg = dict(index_scheme=scheme, index_stop_ticks=300)
+    cfg = dict(index_scheme=scheme, index_stop_ticks=300, seq_mode=1)   # the plant counts its packets
     res = fil.run_fil(m, n, config=cfg, errors=errors, seed=3, every=1)
 
     # the NumPy loop with the same noise draw
@@ -35,12 +35,14 @@ def test_fil_cpp_equals_numpy(scheme):
     sq = np.sqrt(0.01)
     moved = 0
     for k in range(n):
-        g, a, enc = turntable.plant_tick(tab, st, mats, omega[k], force[k], x, w,
-                                         errors.gyro_arw * sq * z[k, :3], errors.accel_vrw * sq * z[k, 3:], 0.01)
-        status, r = fw.step(g, a, enc)
+        g, a, enc, seq = turntable.plant_tick(tab, st, mats, omega[k], force[k], x, w,
+                                              errors.gyro_arw * sq * z[k, :3], errors.accel_vrw * sq * z[k, 3:],
+                                              0.01)
+        status, r = fw.step(g, a, enc, seq)
         assert status == 0
         st.rate_cmd_rad_s = r["motor_rate_cmd_rad_s"]
         c = res.outputs[k]
+        assert c["seq"] == r["seq"] == k + 1, k      # both plants count the IMU's packets alike
         assert abs(res.plant["alpha_rad"][k] - st.alpha_rad) < 1e-10, k
         for f in ("index_state", "index_step", "index_fallbacks"):
             assert c[f] == r[f], (k, f)

@@ -17,8 +17,10 @@ def static_samples(n, lat=0.5):
 
 
 def test_layout_matches_library():
-    assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 56
-    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output()
+    assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 64
+    assert native.SAMPLE_DTYPE.fields["seq"][1] == 56
+    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 400
+    assert native.OUTPUT_DTYPE.itemsize % 8 == 0
     assert native.abi_version() == native.EXPECTED_ABI
     assert native.version() == "0.1.0"
 
@@ -65,15 +67,22 @@ def test_rejected_sample_leaves_state_unchanged():
         fw.run(bad)
     assert info.value.index == 2 and len(info.value.outputs) == 2
     assert info.value.status_name == "PYINS_E_SAMPLE_NONFINITE"
-    # the two good samples were taken, the bad one not
+    # the two good samples were taken, the bad one not: only its fault bit
+    # and counter tell it was there
     after = fw.output()
     assert after["tick"] == before["tick"] + 2
+    assert after["fault_flags"] == native.lib.PYINS_FAULT_SAMPLE_NONFINITE and after["n_nonfinite"] == 1
     fw2 = native.Firmware(lat_rad=0.5)
     fw2.run(samples[:7])
-    assert fw2.output().tobytes() == after.tobytes()
+    ref = fw2.output()
+    ref["fault_flags"], ref["n_nonfinite"] = after["fault_flags"], after["n_nonfinite"]
+    assert ref.tobytes() == after.tobytes()
     with pytest.raises(native.SampleError):
         fw.step([np.inf, 0, 0], [0, 0, 0.1])
-    assert fw.output().tobytes() == after.tobytes()
+    again = fw.output()
+    assert again["n_nonfinite"] == 2
+    again["n_nonfinite"] = 1
+    assert again.tobytes() == after.tobytes()
 
 
 @pytest.mark.parametrize("field", ["dtheta_p_rad", "dv_p_mps", "table_angle_rad"])
