@@ -5,7 +5,8 @@
 #   bash tools/setup.sh --no-demo  # install only
 #
 # Installs the system packages (Eigen, compilers, CMake, Ninja, valgrind, the
-# ARM bare-metal toolchain and QEMU for the Cortex-M builds),
+# ARM bare-metal toolchain and QEMU for the Cortex-M builds, clang and its
+# runtime libraries for the libFuzzer build of tools/fuzz.sh),
 # makes a virtual environment in .venv and installs pyins into it (editable:
 # Python edits take effect at once; after C++ edits run this script again,
 # the C++ build is incremental under build/).
@@ -18,7 +19,8 @@ export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -qq
 $sudo apt-get install -y -qq --no-install-recommends \
     libeigen3-dev g++ cmake ninja-build python3 python3-venv valgrind \
-    gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi qemu-system-arm >/dev/null
+    gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi qemu-system-arm \
+    clang libclang-rt-14-dev >/dev/null
 
 python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip

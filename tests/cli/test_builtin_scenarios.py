@@ -25,7 +25,8 @@ def test_builtin_scenario_runs_and_reports_the_papers_figures(tmp_path, name):
     if name.startswith("seed"):
         assert figures or name == "seed001_fine8", "a paper scenario without the paper's figures"
     for fig in figures:
-        rows = re.findall(rf"<tr><td>{fig['metric']}</td>.*?</tr>", page)
+        variant = re.escape(fig["variant"]) if fig.get("variant") else ".*?"
+        rows = re.findall(rf"<tr><td>{fig['metric']}</td><td>{variant}</td>.*?</tr>", page)
         assert rows, f"{fig['metric']} missing from the report"
         for row in rows:
             cells = re.findall(r"<td>(.*?)</td>", row)

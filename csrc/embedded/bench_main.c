@@ -1,0 +1,98 @@
+/* bench_main.c: instructions per pyins_step in each mode on Cortex-M, under
+ * QEMU with -icount (tools/size_report.py runs it).
+ *
+ * QEMU does not model the DWT cycle counter (CYCCNT reads 0), but with
+ * -icount shift=N its virtual clock advances 2^N ns per guest instruction,
+ * and SysTick (processor clock, 25 MHz on the mps2 boards) counts that
+ * clock. So SysTick counts instructions: one count per 40 / 2^N of them. The
+ * image measures that ratio itself (a block of 1024 NOPs) and the cost of
+ * reading the counter, then times every pyins_step of each mode of
+ * bench_modes.h (the scenarios of tools/bench_step.c on the host):
+ *   CAL nops <instructions> counts <counts> empty <counts>
+ *   MODE <name> ticks <n> sum <counts> max <counts> maxtick <k>
+ *   DONE
+ * These are instruction counts, not cycles: QEMU has no pipeline model. */
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bench_modes.h"
+#include "pyins_core.h"
+
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+
+#ifndef BENCH_TICKS
+#define BENCH_TICKS 3000
+#endif
+
+static unsigned char g_mem[16384] __attribute__((aligned(16)));
+
+/* counts between two readings of the 24-bit down-counter */
+static uint32_t elapsed(uint32_t t0, uint32_t t1) { return (t0 - t1) & 0xFFFFFFu; }
+
+#define NOP8 "nop\n nop\n nop\n nop\n nop\n nop\n nop\n nop\n"
+#define NOP64 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8
+
+int main(void) {
+    pyins_config cfg;
+    pyins_sample s;
+    pyins_output out;
+    uint32_t t0, t1, empty = 0xFFFFFFu, nops = 0;
+    int m, k;
+    SYST_RVR = 0xFFFFFFu;
+    SYST_CVR = 0u;
+    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
+
+    /* calibration: the reading itself, and 1024 instructions */
+    for (k = 0; k < 16; ++k) {
+        t0 = SYST_CVR;
+        t1 = SYST_CVR;
+        if (elapsed(t0, t1) < empty) empty = elapsed(t0, t1);
+    }
+    for (k = 0; k < 4; ++k) {
+        t0 = SYST_CVR;
+        __asm volatile(NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64
+                       NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64);
+        t1 = SYST_CVR;
+        nops += elapsed(t0, t1);
+    }
+    printf("CAL nops %d counts %lu empty %lu\n", 4 * 1024, (unsigned long)nops, (unsigned long)empty);
+
+    if (pyins_core_size() > sizeof g_mem) {
+        printf("FAIL instance too large\n");
+        return 2;
+    }
+    for (m = 0; m < BENCH_N_MODES; ++m) {
+        uint32_t sum = 0, worst = 0;
+        long i, worst_tick = -1;
+        if (bench_config(m, BENCH_TICKS, &cfg) != 0 || pyins_init(g_mem, sizeof g_mem, &cfg) != PYINS_OK) {
+            printf("FAIL init %s\n", bench_mode_name[m]);
+            return 3;
+        }
+        memset(&out, 0, sizeof out);
+        for (i = 0; i < BENCH_TICKS; ++i) {
+            uint32_t c;
+            int st;
+            bench_sample(m, i, out.table_angle_cmd_rad, &s);
+            t0 = SYST_CVR;
+            st = pyins_step((pyins_core *)g_mem, &s, &out);
+            t1 = SYST_CVR;
+            if (st != PYINS_OK) {
+                printf("FAIL step %s %ld %d\n", bench_mode_name[m], i, st);
+                return 4;
+            }
+            c = elapsed(t0, t1);
+            sum += c;
+            if (c > worst) {
+                worst = c;
+                worst_tick = i;
+            }
+        }
+        printf("MODE %s ticks %d sum %lu max %lu maxtick %ld mode %ld\n", bench_mode_name[m], BENCH_TICKS,
+               (unsigned long)sum, (unsigned long)worst, worst_tick, (long)out.mode);
+    }
+    printf("DONE\n");
+    return 0;
+}

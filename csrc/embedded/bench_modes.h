@@ -1,0 +1,81 @@
+/* bench_modes.h: the per-mode benchmark scenarios, the same on every build so
+ * instruction counts compare: tools/bench_step.c on the host (callgrind) and
+ * csrc/embedded/bench_main.c on Cortex-M7/M4F (QEMU -icount), both read by
+ * tools/size_report.py.
+ *
+ * Modes (every tick of the run in that mode):
+ *   nav     NAVIGATE, no indexing (the table fixed)
+ *   navix   NAVIGATE with the two-position scheme, 3 s stops, the table
+ *           reading back the command (stops and 6 deg/s moves)
+ *   coarse  COARSE_ALIGN (first solution at 20 s, then one every 1 s)
+ *   fine5   FINE_ALIGN, 5-state filter (measurement update every 10 ticks)
+ *   fine8   FINE_ALIGN, 8-state filter
+ * The IMU swings gently, so every branch of a moving step runs. */
+#ifndef PYINS_BENCH_MODES_H
+#define PYINS_BENCH_MODES_H
+
+#include <string.h>
+
+#include "pyins_core.h"
+
+enum { BENCH_NAV, BENCH_NAVIX, BENCH_COARSE, BENCH_FINE5, BENCH_FINE8, BENCH_N_MODES };
+
+static const char *const bench_mode_name[BENCH_N_MODES] = {"nav", "navix", "coarse", "fine5", "fine8"};
+
+/* The mode called name, or -1. */
+static int bench_mode_of(const char *name) {
+    int m;
+    for (m = 0; m < BENCH_N_MODES; ++m) {
+        if (strcmp(name, bench_mode_name[m]) == 0) return m;
+    }
+    return -1;
+}
+
+/* The configuration of an n-tick run in mode m; 0, or -1 if the mode cannot
+ * last n ticks. */
+static int bench_config(int m, long n, pyins_config *cfg) {
+    pyins_config_default(cfg);
+    cfg->lat_rad = 0.6;
+    cfg->euler_b_rad[0] = 0.02;
+    cfg->euler_b_rad[1] = -0.03;
+    cfg->euler_b_rad[2] = 1.0;
+    switch (m) {
+        case BENCH_NAV:
+            return 0;
+        case BENCH_NAVIX:
+            cfg->index_scheme = PYINS_INDEX_TWO_POSITION;
+            cfg->index_stop_ticks = 300;
+            return 0;
+        case BENCH_COARSE:
+            cfg->coarse_ticks = 25500;   /* the longest the storage allows at 1 s outputs */
+            return n > cfg->coarse_ticks ? -1 : 0;
+        case BENCH_FINE5:
+        case BENCH_FINE8:
+            cfg->fine_ticks = (int32_t)n + 1;
+            cfg->fine_states = m == BENCH_FINE8 ? 8 : 5;
+            return 0;
+        default:
+            return -1;
+    }
+}
+
+/* Sample i (0-based); table_cmd_rad: the last output's commanded table
+ * angle (the ideal table of navix reads it back; 0 otherwise). */
+static void bench_sample(int m, long i, double table_cmd_rad, pyins_sample *s) {
+    memset(s, 0, sizeof *s);
+    s->dtheta_p_rad[0] = 1e-4 * (double)((i % 200) - 100) / 100.0;
+    s->dtheta_p_rad[1] = 5e-7 + 5e-5 * (double)((i % 300) - 150) / 150.0;
+    s->dtheta_p_rad[2] = 3e-7;
+    s->dv_p_mps[0] = 1e-3;
+    s->dv_p_mps[1] = -2e-3;
+    s->dv_p_mps[2] = 0.0978;
+    s->table_angle_rad = 0.0;
+    if (m == BENCH_NAVIX) {
+        double a = table_cmd_rad;
+        while (a >= 6.283185307179586) a -= 6.283185307179586;
+        while (a < 0.0) a += 6.283185307179586;
+        s->table_angle_rad = a;
+    }
+}
+
+#endif
