@@ -20,7 +20,7 @@ $sudo apt-get update -qq
 $sudo apt-get install -y -qq --no-install-recommends \
     libeigen3-dev g++ cmake ninja-build python3 python3-venv valgrind \
     gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi qemu-system-arm \
-    clang libclang-rt-14-dev >/dev/null
+    clang libclang-rt-14-dev chromium >/dev/null
 
 python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
