@@ -111,7 +111,10 @@ def test_ctrl_c_leaves_a_partial_result_that_resume_completes(tmp_path):
     out = tmp_path / "r"
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen([sys.executable, "-m", "pyins", "run", "seed003", "--out", str(out), "--quiet"],
-                            env=env, stderr=subprocess.PIPE, text=True)
+                            env=env, stderr=subprocess.PIPE, text=True,
+                            # a job started in the background inherits SIGINT ignored, and Python
+                            # then installs no KeyboardInterrupt handler: restore the default
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     rec = out / "no_rotation" / "records" / "records.json"
     t0 = time.monotonic()
     while not rec.exists() and time.monotonic() - t0 < 120:
