@@ -194,8 +194,12 @@ TURNTABLE_KEYS = {
 INDEX_SCHEMES = {"none": 0, "single_position": 1, "seed003": 1, "two_position": 2,
                  "four_position": 3, "flexible": 4, "custom": 5, "flexible_derived": 6}
 _STEP_MOVES = {"fixed": 1, "flex_cos": 2, "flex_sin": 3}
+#: sums name -> pyins_index_sums
+INDEX_SUMS = {"stops": 0, "all": 1}
 INDEXING_KEYS = {
     "scheme": Key("choice", "indexing scheme", "none", choices=tuple(INDEX_SCHEMES)),
+    "sums": Key("choice", "ticks the flexible sums A_c, A_s add up: 'stops' (seed 002) or 'all' "
+                "(turns too)", "stops", choices=tuple(INDEX_SUMS)),
     "stop": _time("stop length of the preset schemes (firmware default 60 s single_position, "
                   "300 s others)", None, lo="0.01 s", hi="1 d"),
     "rate": Key("angular_rate", "cruise rate (firmware default 6 deg/s)", lo="0 deg/s",
@@ -810,6 +814,8 @@ def _firmware_config(res):
                          ("tolerance_rad", "index_tolerance_rad"), ("jump_rad", "index_jump_rad")):
         if ix[name] is not None:
             cfg[c_name] = ix[name]
+    if ix["sums"] != "stops":
+        cfg["index_sums"] = INDEX_SUMS[ix["sums"]]
     if ix["steps"] is not None:
         cfg["index_n_steps"] = len(ix["steps"])
         cfg["index_steps"] = [(_ticks(s["stop_s"]), _STEP_MOVES[s["move"]], s["angle_rad"])
@@ -869,6 +875,7 @@ _STATUS_KEYS = {
     "PYINS_E_CONFIG_NOISE": "firmware", "PYINS_E_CONFIG_INDEX_SCHEME": "indexing.scheme",
     "PYINS_E_CONFIG_INDEX_EMPTY": "indexing.steps", "PYINS_E_CONFIG_INDEX_RATE": "indexing.rate",
     "PYINS_E_CONFIG_INDEX_DELTA": "indexing.delta", "PYINS_E_CONFIG_INDEX_STEP": "indexing",
+    "PYINS_E_CONFIG_INDEX_SUMS": "indexing.sums",
 }
 
 

@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 7
+#define PYINS_ABI_VERSION_MINOR 8
 
 #ifdef __cplusplus
 extern "C" {
@@ -79,6 +79,7 @@ enum pyins_status {
     PYINS_E_SAMPLE_SATURATED = -31,   /* an increment at or beyond its saturation limit; the sample was rejected */
     PYINS_E_CONFIG_SATURATION = -32,  /* a saturation limit negative or not finite */
     PYINS_E_CONFIG_SEQ = -33,         /* unknown seq_mode, or seq_max_gap_ticks outside 0..100 */
+    PYINS_E_CONFIG_INDEX_SUMS = -34,  /* unknown index_sums */
     PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
     PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
     PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
@@ -95,6 +96,14 @@ enum pyins_index_scheme {
     PYINS_INDEX_CUSTOM = 5,           /* index_steps[0 .. index_n_steps-1] */
     PYINS_INDEX_FLEXIBLE_DERIVED = 6  /* seed 002's three-stop derivation: flex-cos fwd, flex-sin rev,
                                          without the fixed 180-deg moves (SPEC 1.6 note 3) */
+};
+
+/* Which ticks add cos psi, sin psi to A_c, A_s (pyins_config.index_sums). */
+enum pyins_index_sums {
+    PYINS_INDEX_SUMS_STOPS = 0,       /* seed 002: stopped ticks only; frozen while turning */
+    PYINS_INDEX_SUMS_ALL = 1          /* every tick of the cycle, turns included: the flexible
+                                         stops then also cancel the drift integrated while
+                                         turning (docs/indexing.md, "What the turns leave") */
 };
 
 /* Move kinds of an indexing step. */
@@ -205,6 +214,8 @@ typedef struct pyins_config {
     int32_t seq_max_gap_ticks;    /* longest gap bridged [ticks], 1..100; 0 = 2 */
     double sat_gyro_rad;          /* angle increment saturation per axis per tick [rad]; 0 = 400 deg/s x tick */
     double sat_accel_mps;         /* velocity increment saturation per axis per tick [m/s]; 0 = 20 g x tick */
+    int32_t index_sums;           /* enum pyins_index_sums; 0 = stops only (seed 002) */
+    int32_t reserved1;            /* padding, ignored; keep 0 */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -243,7 +254,7 @@ typedef struct pyins_output {
     int32_t index_fallbacks;      /* flexible turns that found no heading and stopped at the maximum */
     double motor_rate_cmd_rad_s;  /* commanded table rate */
     double table_angle_cmd_rad;   /* commanded (unwrapped) table angle */
-    double index_a_c;             /* seed 002's cos accumulator A_c */
+    double index_a_c;             /* seed 002's cos accumulator A_c (index_sums says over which ticks) */
     double index_a_s;             /* seed 002's sin accumulator A_s */
     /* Sample-level fault counters since init (saturating at 2^32 - 1), one
      * per pyins_fault_flag bit of the same name. */

@@ -52,6 +52,8 @@ typedef struct pyins_t_index_params {
     double angle[8];
     int32_t n_steps;
     int32_t timeout_ticks;
+    int32_t sums;                 /* enum pyins_index_sums */
+    int32_t reserved;
     double rate, accel, delta, max_flex, tolerance, jump, dt;
 } pyins_t_index_params;
 

@@ -334,6 +334,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_SAMPLE_SATURATED: return "PYINS_E_SAMPLE_SATURATED: an increment is at or beyond its saturation limit; sample rejected, state unchanged";
         case PYINS_E_CONFIG_SATURATION: return "PYINS_E_CONFIG_SATURATION: saturation limits must be positive and finite (0 = default 400 deg/s, 20 g per tick)";
         case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
+        case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
         case PYINS_W_SEQ_GAP: return "PYINS_W_SEQ_GAP: ticks missing before this sample: bridged (navigation) or alignment restarted; sample taken";
         case PYINS_W_SEQ_REPEAT: return "PYINS_W_SEQ_REPEAT: a sample already taken (seq repeated or behind): dropped, state unchanged";
         case PYINS_W_SEQ_LOST: return "PYINS_W_SEQ_LOST: seq jumped beyond the bridgeable gap: sample taken without bridging, sequence resynchronised";
@@ -556,6 +557,7 @@ void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const dou
     prm.tolerance = p->tolerance;
     prm.jump = p->jump;
     prm.timeout_ticks = p->timeout_ticks;
+    prm.sums = p->sums;
     prm.dt = p->dt;
     pyins::indexing::Indexer ix;
     pyins::indexing::init(ix, prm, meas0);

@@ -252,6 +252,9 @@ int config_check(const pyins_config& raw) {
     if (index_status != PYINS_OK) {
         return index_status;
     }
+    if (cfg.index_sums != PYINS_INDEX_SUMS_STOPS && cfg.index_sums != PYINS_INDEX_SUMS_ALL) {
+        return PYINS_E_CONFIG_INDEX_SUMS;
+    }
     if ((cfg.seq_mode != PYINS_SEQ_OFF && cfg.seq_mode != PYINS_SEQ_CHECK) ||
         cfg.seq_max_gap_ticks < 1 || cfg.seq_max_gap_ticks > kMaxSeqGap) {
         return PYINS_E_CONFIG_SEQ;
@@ -327,6 +330,7 @@ void Firmware::init(const pyins_config& raw) {
     ip.tolerance = cfg.index_tolerance_rad;
     ip.jump = cfg.index_jump_rad;
     ip.timeout_ticks = cfg.index_timeout_ticks;
+    ip.sums = cfg.index_sums;
     ip.dt = dt_;
     // Before NAVIGATE the table is held where it is (an idle machine, command 0).
     indexing::Params idle = ip;

@@ -188,6 +188,15 @@ void update(Indexer& ix, double meas, double yaw_p) {
         return;
     }
     // kMove
+    if (ix.prm.sums == 1) {
+        // our extension: the turn's ticks count too (before the test, as a
+        // stopped tick's heading counts before its stop may end)
+        double sn;
+        double cs;
+        pmath::sincos(yaw_p, &sn, &cs);
+        ix.a_c = ix.a_c + cs;
+        ix.a_s = ix.a_s + sn;
+    }
     const Step& s = ix.prm.steps[ix.step];
     if (!ix.target_known) {
         if (flex_condition(ix, s.kind, yaw_p)) {

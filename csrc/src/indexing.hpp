@@ -12,7 +12,11 @@
 // psi is the IMU yaw psi_p = psi_b + alpha from the firmware's own solution
 // (counter-clockwise, DESIGN.md); A_c, A_s accumulate cos psi, sin psi on
 // every tick the table is stopped, are frozen while it turns and are never
-// reset; N_p is the stop's length in ticks (SPEC 1.6 reading (b)).
+// reset (seed 002, sec. 2); N_p is the stop's length in ticks (SPEC 1.6
+// reading (b)). With `sums` = 1 (PYINS_INDEX_SUMS_ALL, our extension) they
+// also accumulate while the table turns: the drift integrated over the turns
+// (about 9 % of the time at 300-s stops) is then cancelled by the flexible
+// stops too, which seed 002's rule leaves uncontrolled (docs/indexing.md).
 //
 // Choices the paper leaves open (docs/indexing.md):
 // - "opposite sign" takes zero as either sign (sin psi * A_s <= 0);
@@ -53,6 +57,7 @@ struct Params {
     double tolerance;      ///< position tolerance [rad]
     double jump;           ///< largest believable encoder change in one tick [rad]
     int32_t timeout_ticks; ///< how long the encoder may lag
+    int32_t sums;          ///< 0: A_c, A_s over stopped ticks (seed 002); 1: every tick
     double dt;             ///< tick [s]
 };
 
@@ -64,8 +69,8 @@ struct Indexer {
     int32_t stop_count;    ///< ticks stopped in this step
     int32_t lag_ticks;     ///< consecutive ticks the encoder is off the command
     int32_t fallbacks;     ///< flexible turns that ended at max_flex
-    double a_c;            ///< sum of cos psi over stopped ticks
-    double a_s;            ///< sum of sin psi over stopped ticks
+    double a_c;            ///< sum of cos psi over stopped ticks (every tick with sums = 1)
+    double a_s;            ///< sum of sin psi over the same ticks
     double cmd_angle;      ///< commanded (unwrapped) table angle [rad]
     double cmd_rate;       ///< commanded rate [rad/s] (signed)
     double target;         ///< where the current move ends [rad]

@@ -47,6 +47,7 @@ PYINS_E_SNAPSHOT_CORRUPT = -30
 PYINS_E_SAMPLE_SATURATED = -31
 PYINS_E_CONFIG_SATURATION = -32
 PYINS_E_CONFIG_SEQ = -33
+PYINS_E_CONFIG_INDEX_SUMS = -34
 PYINS_W_SEQ_GAP = 1          #: notices: the sample was handled (docs/core.md)
 PYINS_W_SEQ_REPEAT = 2
 PYINS_W_SEQ_LOST = 3
@@ -153,6 +154,8 @@ def config_default():
         "seq_max_gap_ticks": 0,
         "sat_gyro_rad": 0.0,
         "sat_accel_mps": 0.0,
+        "index_sums": indexing.SUMS_STOPS,
+        "reserved1": 0,
     }
 
 
@@ -289,6 +292,8 @@ def config_check(raw):
     index_status = index_check(cfg)
     if index_status != PYINS_OK:
         return index_status
+    if cfg["index_sums"] not in (indexing.SUMS_STOPS, indexing.SUMS_ALL):
+        return PYINS_E_CONFIG_INDEX_SUMS
     if cfg["seq_mode"] not in (SEQ_OFF, SEQ_CHECK) or not 1 <= cfg["seq_max_gap_ticks"] <= MAX_SEQ_GAP:
         return PYINS_E_CONFIG_SEQ
     sat = (cfg["sat_gyro_rad"], cfg["sat_accel_mps"])
@@ -383,7 +388,7 @@ class Firmware:
             steps=steps, rate=cfg["index_rate_rad_s"], accel=cfg["index_accel_rad_s2"],
             delta=cfg["index_delta"], max_flex=cfg["index_max_flex_rad"],
             tolerance=cfg["index_tolerance_rad"], jump=cfg["index_jump_rad"],
-            timeout_ticks=cfg["index_timeout_ticks"], dt=self.dt)
+            timeout_ticks=cfg["index_timeout_ticks"], dt=self.dt, sums=cfg["index_sums"])
         idle = indexing.Params(**{**self.index_prm.__dict__, "steps": []})
         self.idx = indexing.init(idle, self.table_angle)
         self.coarse = None

@@ -4,6 +4,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+SUMS_STOPS = 0       #: PYINS_INDEX_SUMS_STOPS: A_c, A_s over stopped ticks (seed 002)
+SUMS_ALL = 1         #: PYINS_INDEX_SUMS_ALL: over every tick, turns included (our extension)
+
 KIND_FIXED = 1       #: Kind::kFixed
 KIND_FLEX_COS = 2    #: Kind::kFlexCos
 KIND_FLEX_SIN = 3    #: Kind::kFlexSin
@@ -39,6 +42,7 @@ class Params:
     jump: float
     timeout_ticks: int
     dt: float
+    sums: int = SUMS_STOPS   # (C++: after timeout_ticks; a default here keeps old callers working)
 
     @property
     def n_steps(self):
@@ -198,6 +202,10 @@ def update(ix, meas, yaw_p):
         if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
             _start_move(ix)
         return
+    if ix.prm.sums == SUMS_ALL:
+        # our extension: the turn's ticks count too (before the test)
+        ix.a_c = ix.a_c + np.cos(yaw_p)
+        ix.a_s = ix.a_s + np.sin(yaw_p)
     s = ix.prm.steps[ix.step]
     if not ix.target_known:
         if _flex_condition(ix, s.kind, yaw_p):

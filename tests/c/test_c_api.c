@@ -95,6 +95,7 @@ int main(void) {
                              PYINS_E_CONFIG_INDEX_STEP, PYINS_E_SNAPSHOT_SIZE,
                              PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT,
                              PYINS_E_SAMPLE_SATURATED, PYINS_E_CONFIG_SATURATION, PYINS_E_CONFIG_SEQ,
+                             PYINS_E_CONFIG_INDEX_SUMS,
                              PYINS_W_SEQ_GAP, PYINS_W_SEQ_REPEAT, PYINS_W_SEQ_LOST, PYINS_W_ENCODER_JUMP};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
@@ -114,7 +115,8 @@ int main(void) {
               PYINS_E_NOT_INIT == -4 && PYINS_E_SAMPLE_NONFINITE == -5 && PYINS_E_CONFIG_RATE == -10 &&
               PYINS_E_CONFIG_LAT == -11 && PYINS_E_CONFIG_MODE == -16, "pinned status values");
         check(PYINS_E_SNAPSHOT_CORRUPT == -30 && PYINS_E_SAMPLE_SATURATED == -31 &&
-              PYINS_E_CONFIG_SATURATION == -32 && PYINS_E_CONFIG_SEQ == -33 && PYINS_W_SEQ_GAP == 1 &&
+              PYINS_E_CONFIG_SATURATION == -32 && PYINS_E_CONFIG_SEQ == -33 && PYINS_E_CONFIG_INDEX_SUMS == -34 &&
+              PYINS_W_SEQ_GAP == 1 &&
               PYINS_W_SEQ_REPEAT == 2 && PYINS_W_SEQ_LOST == 3 && PYINS_W_ENCODER_JUMP == 4,
               "pinned sample-level status values");
         check(PYINS_FAULT_SAMPLE_NONFINITE == 4 && PYINS_FAULT_SAMPLE_SATURATED == 8 && PYINS_FAULT_SEQ_GAP == 16 &&
@@ -198,6 +200,10 @@ int main(void) {
     BAD_CFG(b.seq_mode = -1, PYINS_E_CONFIG_SEQ, "negative seq mode");
     BAD_CFG(b.seq_max_gap_ticks = -1, PYINS_E_CONFIG_SEQ, "negative seq gap");
     BAD_CFG(b.seq_max_gap_ticks = 101, PYINS_E_CONFIG_SEQ, "seq gap beyond 100 ticks");
+    BAD_CFG(b.index_sums = 2, PYINS_E_CONFIG_INDEX_SUMS, "unknown index_sums");
+    BAD_CFG(b.index_sums = -1, PYINS_E_CONFIG_INDEX_SUMS, "negative index_sums");
+    BAD_CFG((b.index_scheme = PYINS_INDEX_NONE, b.index_sums = 7), PYINS_E_CONFIG_INDEX_SUMS,
+            "unknown index_sums refused even without rotation");
     BAD_CFG(b.sat_gyro_rad = -0.1, PYINS_E_CONFIG_SATURATION, "negative gyro saturation");
     BAD_CFG(b.sat_gyro_rad = NAN, PYINS_E_CONFIG_SATURATION, "NaN gyro saturation");
     BAD_CFG(b.sat_accel_mps = INFINITY, PYINS_E_CONFIG_SATURATION, "Inf accel saturation");

@@ -15,14 +15,15 @@ from pyins.sim import turntable
 DEG = earth.DEG_TO_RAD
 
 
-@pytest.mark.parametrize("scheme", [2, 4])
-def test_fil_cpp_equals_numpy(scheme):
+@pytest.mark.parametrize("scheme, sums", [(2, 0), (4, 0), (6, 1)])
+def test_fil_cpp_equals_numpy(scheme, sums):
     m = sim.HeadingSwing.experiment(1)
     n = 1500
     errors = sim.preset("seed002")
     errors.gyro_quantum = 1e-7
     errors.accel_quantum = 1e-5
-    cfg = dict(index_scheme=scheme, index_stop_ticks=300, seq_mode=1)   # the plant counts its packets
+    cfg = dict(index_scheme=scheme, index_stop_ticks=300, seq_mode=1,   # the plant counts its packets
+               index_sums=sums)
     res = fil.run_fil(m, n, config=cfg, errors=errors, seed=3, every=1)
 
     # the NumPy loop with the same noise draw

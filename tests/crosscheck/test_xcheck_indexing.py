@@ -3,9 +3,11 @@ on random schemes and ship-heading traces (hypothesis), with an ideal encoder
 (the table is where it was commanded one tick before).
 
 Properties (issue 4): stops last exactly their ticks; positions and
-directions follow the scheme; A_c, A_s change only while stopped; a flexible
-turn starts braking on the first tick the condition holds; C++ and NumPy give
-the same state and command sequence tick for tick.
+directions follow the scheme; A_c, A_s change only while stopped (seed 002's
+rule, index_sums = stops) or on every tick, each time by the cos and sin of
+that tick's IMU heading (index_sums = all); a flexible turn starts braking on
+the first tick the condition holds; C++ and NumPy give the same state and
+command sequence tick for tick.
 """
 import numpy as np
 from hypothesis import given, settings
@@ -26,7 +28,8 @@ def setups(draw):
     steps = ix.preset_steps(scheme, stop)
     prm = ix.Params(steps=steps, rate=draw(st.sampled_from([6.0, 10.0, 30.0])) * DEG,
                     accel=draw(st.sampled_from([30.0, 100.0, 1e4])) * DEG, delta=0.01,
-                    max_flex=2 * np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=0.01)
+                    max_flex=2 * np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=0.01,
+                    sums=draw(st.sampled_from([ix.SUMS_STOPS, ix.SUMS_ALL])))
     n = draw(st.integers(500, 6000))
     t = np.arange(n) * 0.01
     amp = draw(st.floats(0.0, 120.0)) * DEG
@@ -41,6 +44,7 @@ def c_run(prm, meas0, yaw_b):
         p.stop_ticks[i], p.kind[i], p.angle[i] = s.stop_ticks, s.kind, s.angle
     p.n_steps = prm.n_steps
     p.timeout_ticks = prm.timeout_ticks
+    p.sums = prm.sums
     p.rate, p.accel, p.delta, p.max_flex = prm.rate, prm.accel, prm.delta, prm.max_flex
     p.tolerance, p.jump, p.dt = prm.tolerance, prm.jump, prm.dt
     y = np.ascontiguousarray(yaw_b)
@@ -86,11 +90,21 @@ def test_scheme_rules(setup):
     prev_ac = np.concatenate([[0.0], rec["a_c"][:-1]])
     prev_as = np.concatenate([[0.0], rec["a_s"][:-1]])
     acc = (rec["a_c"] != prev_ac) | (rec["a_s"] != prev_as)
-    # A_c, A_s change only while stopped: the commanded angle does not move
+    # stopped ticks: the command neither moves nor has a rate (a turn moves it on every tick)
     prev_cmd = np.concatenate([[rec["cmd_angle"][0]], rec["cmd_angle"][:-1]])
-    assert np.all(rec["cmd_angle"][acc] == prev_cmd[acc]) and np.all(rec["cmd_rate"][acc] == 0.0)
-    # stops last exactly their ticks: every complete run of accumulating ticks
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], acc.astype(int), [0]])))
+    stopped = (rec["cmd_angle"] == prev_cmd) & (rec["cmd_rate"] == 0.0)
+    # the heading each tick's update saw: ship yaw + the table where it was commanded before
+    psi_all = yaw_b + np.concatenate([[meas0], rec["cmd_angle"][:-1]])
+    if prm.sums == ix.SUMS_STOPS:
+        # seed 002: A_c, A_s change on the stopped ticks and only there
+        assert np.array_equal(acc, stopped)
+    else:
+        # every tick adds its own heading's cos and sin, turns included
+        assert np.all(acc)
+        np.testing.assert_allclose(rec["a_c"], np.cumsum(np.cos(psi_all)), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(rec["a_s"], np.cumsum(np.sin(psi_all)), rtol=0, atol=1e-9)
+    # stops last exactly their ticks: every complete run of stopped ticks
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], stopped.astype(int), [0]])))
     for a, b in zip(edges[::2], edges[1::2]):
         if b < len(state):
             assert b - a == prm.steps[step[a]].stop_ticks
@@ -110,7 +124,8 @@ def test_scheme_rules(setup):
         else:
             # flexible: braking starts on the first tick the condition holds
             n_p = float(s.stop_ticks)
-            ac, as_ = rec["a_c"][k], rec["a_s"][k]
+            # the sums each tick's test saw (frozen with sums = stops; growing with all)
+            ac, as_ = rec["a_c"][k:end + 1], rec["a_s"][k:end + 1]
             psi = yaw_b[k:end + 1] + np.concatenate([[start], rec["cmd_angle"][k:end]])
             if s.kind == ix.KIND_FLEX_COS:
                 cond = (np.abs(np.cos(psi) + ac / n_p) < prm.delta) & (np.sin(psi) * as_ <= 0)

@@ -202,7 +202,7 @@ static const field kFields[] = {
     FLD(index_n_steps, T_I32), FLD(index_rate_rad_s, T_F64), FLD(index_accel_rad_s2, T_F64),
     FLD(index_delta, T_F64), FLD(index_max_flex_rad, T_F64), FLD(index_tolerance_rad, T_F64),
     FLD(index_jump_rad, T_F64), FLD(seq_mode, T_I32), FLD(seq_max_gap_ticks, T_I32),
-    FLD(sat_gyro_rad, T_F64), FLD(sat_accel_mps, T_F64),
+    FLD(sat_gyro_rad, T_F64), FLD(sat_accel_mps, T_F64), FLD(index_sums, T_I32), FLD(reserved1, T_I32),
 };
 #undef FLD
 #define N_FIELDS ((int)(sizeof kFields / sizeof kFields[0]))
@@ -278,10 +278,11 @@ static void preset(int k, pyins_config *c) {
             c->index_timeout_ticks = 3;
             c->index_tolerance_rad = 0.05;
             break;
-        case 5: /* the derived flexible scheme after a short fine alignment */
+        case 5: /* the derived flexible scheme, turns summed, after a short fine alignment */
             c->fine_ticks = 50;
             c->fine_meas_every_ticks = 1;
             c->index_scheme = PYINS_INDEX_FLEXIBLE_DERIVED;
+            c->index_sums = PYINS_INDEX_SUMS_ALL;
             c->index_stop_ticks = 20;
             c->index_delta = 0.5;
             break;

@@ -21,12 +21,12 @@ def closed_loop(fw_step, n, dtheta, dv, follow):
     return recs
 
 
-@pytest.mark.parametrize("scheme", [1, 2, 3, 4])
-def test_cpp_equals_reference_in_closed_loop(scheme):
+@pytest.mark.parametrize("scheme, sums", [(1, 0), (2, 0), (3, 0), (4, 0), (6, 0), (4, 1), (6, 1)])
+def test_cpp_equals_reference_in_closed_loop(scheme, sums):
     m = sim.HeadingSwing.experiment(1)
     n = 4000
     dtheta, dv, _ = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, index_scheme=scheme, index_stop_ticks=400)
+    cfg = runner.initial_config(m, None, index_scheme=scheme, index_stop_ticks=400, index_sums=sums)
     fw = native.Firmware(cfg)
     ref = ref_firmware.Firmware(cfg)
 
@@ -43,6 +43,13 @@ def test_cpp_equals_reference_in_closed_loop(scheme):
             assert abs(x[f] - y[f]) <= 1e-9 * max(1.0, abs(y[f])), (k, f)
         moves += x["index_state"] == 2
     assert moves > 100                                  # the table really turned
+    # the sums over the turns too (index_sums = 1) or only over the stops
+    a_c = np.array([x["index_a_c"] for x in c])
+    # a tick is a turn's when the machine was turning before it (a record shows
+    # the state after its tick: the last stopped tick already reads MOVE)
+    turning = np.concatenate([[False], [x["index_state"] == 2 for x in c[:-1]]])
+    changed = np.concatenate([[False], np.diff(a_c) != 0.0])
+    assert np.any(changed & turning) == (sums == 1)
 
 
 def _faulting(follow, n=3000):
@@ -94,5 +101,8 @@ def test_custom_scheme_and_config_errors():
         native.Firmware(index_scheme=5, index_n_steps=1, index_rate_rad_s=0.1, index_accel_rad_s2=1.0,
                         index_delta=0.0, index_steps=[(50, 2, 1.0)])
     assert info.value.status_name == "PYINS_E_CONFIG_INDEX_DELTA"
+    with pytest.raises(native.ConfigError) as info:
+        native.Firmware(index_scheme=6, index_sums=2)
+    assert info.value.status_name == "PYINS_E_CONFIG_INDEX_SUMS"
     with pytest.raises(ValueError, match=r"index_steps\[0\]"):
         native.Firmware(index_steps=[(1, 2)])

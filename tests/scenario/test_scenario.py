@@ -258,6 +258,9 @@ angle = "-180 deg"
     assert r.config["index_n_steps"] == 2 and r.config["index_scheme"] == 5
     assert r.config["table_angle_rad"] == 90.0 * DEG
     assert r.table.fault == sim.turntable.TABLE_STALL and r.table.fault_tick == 10_000
+    assert "index_sums" not in r.config                  # seed 002's rule unless asked
+    (r,) = scenario.loads(text.replace('delta = 0.01', 'delta = 0.01\nsums = "all"')).runs()
+    assert r.config["index_sums"] == 1
     legs = "\n".join(['[[motion.segments]]\nkind = "accelerate"\nduration = "60 s"\nspeed = "5 knot"',
                       '[[motion.segments]]\nkind = "turn"\nduration = "30 s"\nangle = "45 deg"'])
     (r,) = scenario.loads('duration = "90 s"\n[motion]\nkind = "manoeuvre"\n' + legs).runs()
@@ -413,6 +416,8 @@ MISTAKES = [
      "unknown value 'seed004'; did you mean 'seed003'? (choose one of error_free, seed000"),
     ("unknown scheme", 'duration = "1 h"\n' + MOTION + '[indexing]\nscheme = "flexibel"\n', "indexing.scheme",
      "unknown value 'flexibel'; did you mean 'flexible'?"),
+    ("unknown sums", 'duration = "1 h"\n' + MOTION + '[indexing]\nscheme = "flexible_derived"\nsums = "turns"\n',
+     "indexing.sums", "unknown value 'turns'"),
     ("unknown motion kind", 'duration = "1 h"\n[motion]\nkind = "statik"\n', "motion.kind",
      "unknown value 'statik'; did you mean 'static'?"),
     ("unknown metric", 'duration = "1 h"\n' + MOTION + '[[paper.figures]]\nmetric = "horizontal_error"\n'
