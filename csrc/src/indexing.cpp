@@ -54,11 +54,9 @@ bool off_command(Indexer& ix, double meas, Fault f) {
     return false;
 }
 
-/// The flexible stop condition of seed 002 on this tick's heading.
-bool flex_condition(const Indexer& ix, Kind kind, double yaw_p) {
-    double s;
-    double c;
-    pmath::sincos(yaw_p, &s, &c);
+/// The flexible stop condition of seed 002 on this tick's heading (s, c =
+/// its sin and cos).
+bool flex_condition(const Indexer& ix, Kind kind, double s, double c) {
     const double n_p = static_cast<double>(ix.prm.steps[ix.step].stop_ticks);
     if (kind == Kind::kFlexCos) {
         return std::fabs(c + ix.a_c / n_p) < ix.prm.delta && s * ix.a_s <= 0.0;
@@ -187,19 +185,22 @@ void update(Indexer& ix, double meas, double yaw_p) {
         }
         return;
     }
-    // kMove
-    if (ix.prm.sums == 1) {
+    // kMove: the heading's sin and cos only where they are used, once
+    const Step& s = ix.prm.steps[ix.step];
+    const bool sum_turn = ix.prm.sums == kSumsAll;
+    double sn = 0.0;
+    double cs = 0.0;
+    if (sum_turn || !ix.target_known) {
+        pmath::sincos(yaw_p, &sn, &cs);
+    }
+    if (sum_turn) {
         // our extension: the turn's ticks count too (before the test, as a
         // stopped tick's heading counts before its stop may end)
-        double sn;
-        double cs;
-        pmath::sincos(yaw_p, &sn, &cs);
         ix.a_c = ix.a_c + cs;
         ix.a_s = ix.a_s + sn;
     }
-    const Step& s = ix.prm.steps[ix.step];
     if (!ix.target_known) {
-        if (flex_condition(ix, s.kind, yaw_p)) {
+        if (flex_condition(ix, s.kind, sn, cs)) {
             // stop as soon as the profile allows: brake from here
             const double v = std::fabs(ix.cmd_rate);
             ix.target = ix.cmd_angle + sense(s.angle) * (v * v / (2.0 * ix.prm.accel));

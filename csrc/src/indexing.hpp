@@ -40,6 +40,8 @@ enum class State : int32_t { kIdle = 0, kStop = 1, kMove = 2, kFault = 3 };
 enum class Fault : int32_t { kNone = 0, kLag = 1, kJump = 2, kDrift = 3 };
 
 inline constexpr int kMaxSteps = 8;
+inline constexpr int32_t kSumsStops = 0;   ///< PYINS_INDEX_SUMS_STOPS (seed 002)
+inline constexpr int32_t kSumsAll = 1;     ///< PYINS_INDEX_SUMS_ALL (turns too)
 
 struct Step {
     int32_t stop_ticks;
@@ -57,7 +59,7 @@ struct Params {
     double tolerance;      ///< position tolerance [rad]
     double jump;           ///< largest believable encoder change in one tick [rad]
     int32_t timeout_ticks; ///< how long the encoder may lag
-    int32_t sums;          ///< 0: A_c, A_s over stopped ticks (seed 002); 1: every tick
+    int32_t sums;          ///< kSumsStops: A_c, A_s over stopped ticks (seed 002); kSumsAll: every tick
     double dt;             ///< tick [s]
 };
 

@@ -139,9 +139,7 @@ def _off_command(ix, meas, fault):
     return False
 
 
-def _flex_condition(ix, kind, yaw_p):
-    s = np.sin(yaw_p)
-    c = np.cos(yaw_p)
+def _flex_condition(ix, kind, s, c):
     n_p = float(ix.prm.steps[ix.step].stop_ticks)
     if kind == KIND_FLEX_COS:
         return abs(c + ix.a_c / n_p) < ix.prm.delta and s * ix.a_s <= 0.0
@@ -202,13 +200,18 @@ def update(ix, meas, yaw_p):
         if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
             _start_move(ix)
         return
-    if ix.prm.sums == SUMS_ALL:
-        # our extension: the turn's ticks count too (before the test)
-        ix.a_c = ix.a_c + np.cos(yaw_p)
-        ix.a_s = ix.a_s + np.sin(yaw_p)
+    # kMove: the heading's sin and cos only where they are used, once
     s = ix.prm.steps[ix.step]
+    sum_turn = ix.prm.sums == SUMS_ALL
+    sn = cs = 0.0
+    if sum_turn or not ix.target_known:
+        sn, cs = np.sin(yaw_p), np.cos(yaw_p)
+    if sum_turn:
+        # our extension: the turn's ticks count too (before the test)
+        ix.a_c = ix.a_c + cs
+        ix.a_s = ix.a_s + sn
     if not ix.target_known:
-        if _flex_condition(ix, s.kind, yaw_p):
+        if _flex_condition(ix, s.kind, sn, cs):
             v = abs(ix.cmd_rate)
             ix.target = ix.cmd_angle + _sense(s.angle) * (v * v / (2.0 * ix.prm.accel))
             ix.target_known = True
