@@ -191,3 +191,14 @@ def predict_static_fil(result, lat, euler_b, gyro_bias_p, accel_bias_p, times_s,
     return static_error_model(lat, times_s, table_projected(gyro_bias_p, euler_b, t_rec, alpha, alpha0),
                               table_projected(accel_bias_p, euler_b, t_rec, alpha, alpha0),
                               step_s=step_s)
+
+
+def drift_surviving(yaw_p, mask=None):
+    """The fraction of a constant x/y drift of the IMU that survives the
+    modulation (SPEC 1.10's proxy): |sum of [cos psi, sin psi]| / number of
+    samples, psi the IMU yaw sampled uniformly (e.g. an output record every
+    second). With ``mask`` only the masked samples are summed (still divided
+    by all of them), e.g. the stopped ones: the parts add up as vectors."""
+    psi = np.asarray(yaw_p, dtype=float)
+    sel = psi if mask is None else psi[np.asarray(mask, dtype=bool)]
+    return float(np.hypot(np.cos(sel).sum(), np.sin(sel).sum()) / len(psi))

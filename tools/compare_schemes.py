@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from pyins import fil, runner, sim
+from pyins import analysis, fil, runner, sim
 from pyins.reference import earth
 from pyins.sim import motion
 from pyins.sim.turntable import TableConfig
@@ -55,10 +55,9 @@ def run_one(m, scheme, sums, accel_deg, hours, progress):
                       config=dict(index_scheme=scheme, index_sums=sums, index_accel_rad_s2=accel_deg * DEG),
                       table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress)
     e = runner.nav_errors(res)
-    psi = np.asarray(res.outputs["yaw_p_rad"])
     return {"max_nmi": float(e.horizontal_m.max() / earth.NMI_TO_M),
             "final_nmi": float(e.horizontal_m[-1] / earth.NMI_TO_M),
-            "survives": float(np.hypot(np.cos(psi).sum(), np.sin(psi).sum()) / len(psi)),
+            "survives": analysis.drift_surviving(res.outputs["yaw_p_rad"]),
             "fallbacks": int(res.outputs["index_fallbacks"][-1])}
 
 

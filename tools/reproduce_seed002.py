@@ -32,7 +32,7 @@ import sys
 
 import numpy as np
 
-from pyins import fil, runner, sim
+from pyins import analysis, fil, runner, sim
 from pyins.sim.turntable import TableConfig
 from pyins.reference import attitude, earth
 
@@ -87,18 +87,14 @@ def run_one(exp, scheme, sums, errors, with_init, accel, hours, seed):
     res = fil.run_fil(m, int(hours * 360_000), config=cfg, errors=errors, seed=seed, every=100,
                       table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=fil.TextProgress())
     e = runner.nav_errors(res)
-    psi = np.asarray(res.outputs["yaw_p_rad"])
-    # SPEC 1.10's proxy: the fraction of a constant x/y drift that survives
-    # modulation, |integral of [cos, sin] of the IMU heading| / duration
-    # (from the 1 Hz records), split into the stopped and the turning part
-    cs = np.stack([np.cos(psi), np.sin(psi)])
+    psi = res.outputs["yaw_p_rad"]
+    # SPEC 1.10's proxy (from the 1 Hz records), split into the stopped and the turning part
     stopped = np.asarray(res.outputs["index_state"]) != 2
-    n = len(psi)
     return dict(final_nmi=float(e.horizontal_m[-1] / earth.NMI_TO_M),
                 max_nmi=float(e.horizontal_m.max() / earth.NMI_TO_M),
-                survives=float(np.hypot(*cs.sum(axis=1)) / n),
-                survives_stops=float(np.hypot(*cs[:, stopped].sum(axis=1)) / n),
-                survives_turns=float(np.hypot(*cs[:, ~stopped].sum(axis=1)) / n),
+                survives=analysis.drift_surviving(psi),
+                survives_stops=analysis.drift_surviving(psi, stopped),
+                survives_turns=analysis.drift_surviving(psi, ~stopped),
                 fallbacks=int(res.outputs["index_fallbacks"][-1]),
                 index_faults=int(np.count_nonzero(res.outputs["index_fault"]))), e
 

@@ -46,3 +46,16 @@ def test_static_run_matches_linear_error_model(scheme):
         # what modulation cannot remove: the up gyro's drift, i.e. the part of
         # the drift along the Earth's axis that feeds the longitude error
         assert model.horizontal_m[-1] > 1000.0
+
+
+def test_drift_surviving_proxy():
+    """SPEC 1.10's proxy: a fixed IMU keeps all of a constant drift (1), a
+    uniform full turn cancels it (0 to rounding), and the masked parts add
+    up as vectors to the whole."""
+    assert analysis.drift_surviving(np.full(100, 0.3)) == pytest.approx(1.0, abs=1e-15)
+    turn = np.linspace(0.0, 2 * np.pi, 3600, endpoint=False)
+    assert analysis.drift_surviving(turn) < 1e-15
+    # the first half turn alone leaves |sum of [cos, sin]| = 1/sin(pi/3600) of 3600 samples
+    half = turn < np.pi
+    assert analysis.drift_surviving(turn, half) == pytest.approx(1.0 / np.sin(np.pi / 3600) / 3600, rel=1e-9)
+    assert analysis.drift_surviving(turn, half) == pytest.approx(analysis.drift_surviving(turn, ~half), rel=1e-9)
