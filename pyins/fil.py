@@ -65,15 +65,20 @@ class TextProgress:
 def periodic_ticks(motion, dt, limit=2_000_000):
     """Ticks after which the ship's body rate and force repeat exactly, or
     None. Static: 1. Swings: the least common multiple of each active
-    frequency's whole-tick period (at most 1000 cycles)."""
+    frequency's whole-tick period (at most 1000 cycles). A ShipAtSea: the
+    same over the base swing's and the linear motion's frequencies (1 when
+    nothing moves)."""
     if isinstance(motion, sim.Static):
         return 1
-    if not isinstance(motion, sim.Swing):
+    if isinstance(motion, sim.ShipAtSea):
+        freqs = motion.frequencies_hz
+    elif isinstance(motion, sim.Swing):
+        freqs = [f for amp, f in zip(motion.amplitude, motion.frequency_hz)
+                 if amp != 0.0 and f != 0.0]
+    else:
         return None
     period = 1
-    for amp, f in zip(motion.amplitude, motion.frequency_hz):
-        if amp == 0.0 or f == 0.0:
-            continue
+    for f in freqs:
         ticks_per_cycle = 1.0 / (f * dt)
         for cycles in range(1, 1001):
             p = cycles * ticks_per_cycle

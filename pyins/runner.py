@@ -35,8 +35,19 @@ class NavErrors:
 
 
 def initial_config(motion, table=None, **overrides):
-    """Firmware configuration holding the true state of ``motion`` at t = 0."""
-    st = motion.state(np.array([0.0]))
+    """Firmware configuration holding the true state of ``motion`` at t = 0.
+
+    The state is the ship's reference point's (`pyins.sim.ShipAtSea`'s
+    ``reference_state``), which is what the firmware's configuration and
+    records mean when a lever arm is configured; ``lever_b_m``/``lever_p_m``
+    come from the motion's lever arms unless overridden.
+    """
+    if hasattr(motion, "reference_state"):
+        st = motion.reference_state(np.array([0.0]))
+        overrides = {"lever_b_m": np.asarray(motion.lever_b, dtype=float),
+                     "lever_p_m": np.asarray(motion.lever_p, dtype=float), **overrides}
+    else:
+        st = motion.state(np.array([0.0]))
     alpha0 = 0.0 if table is None else float(table.state(np.array([0.0]))[0][0])
     cfg = dict(lat_rad=float(st.lat[0]), lon_rad=float(st.lon[0]), height_m=float(st.height[0]),
                vel_n_mps=st.vel_n[0], euler_b_rad=st.euler[0], table_angle_rad=alpha0)

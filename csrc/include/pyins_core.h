@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 8
+#define PYINS_ABI_VERSION_MINOR 9
 
 #ifdef __cplusplus
 extern "C" {
@@ -80,6 +80,8 @@ enum pyins_status {
     PYINS_E_CONFIG_SATURATION = -32,  /* a saturation limit negative or not finite */
     PYINS_E_CONFIG_SEQ = -33,         /* unknown seq_mode, or seq_max_gap_ticks outside 0..100 */
     PYINS_E_CONFIG_INDEX_SUMS = -34,  /* unknown index_sums */
+    PYINS_E_CONFIG_LEVER = -35,       /* a lever-arm component not finite, or a lever arm longer than 100 m */
+    PYINS_E_CONFIG_COARSE_METHOD = -36, /* unknown coarse_method */
     PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
     PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
     PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
@@ -124,6 +126,16 @@ typedef struct pyins_index_step {
     int32_t kind;                 /* enum pyins_index_kind */
     double angle_rad;
 } pyins_index_step;
+
+/* How the coarse alignment solves C_ib0^i (pyins_config.coarse_method). */
+enum pyins_coarse_method {
+    PYINS_COARSE_TRIAD = 0,       /* seed 000: the velocity integrals at t_k1 = r t_k2 and t_k2 (TRIAD);
+                                     assumes the IMU at rest at t0 and no linear motion */
+    PYINS_COARSE_FIT = 1          /* moving base: the integrals of the velocity integrals weighted by two
+                                     smooth functions that ignore an unknown initial velocity and
+                                     position offset and suppress bounded wave motion
+                                     (docs/concepts.md, "Alignment on a moving base") */
+};
 
 /* How the fine alignment uses its attitude estimate. */
 enum pyins_fine_correction {
@@ -216,6 +228,13 @@ typedef struct pyins_config {
     double sat_accel_mps;         /* velocity increment saturation per axis per tick [m/s]; 0 = 20 g x tick */
     int32_t index_sums;           /* enum pyins_index_sums; 0 = stops only (seed 002) */
     int32_t reserved1;            /* padding, ignored; keep 0 */
+    /* Lever arms (docs/concepts.md, "Lever arms"). The firmware navigates the
+     * accelerometer triad and reports the reference point: position, velocity
+     * and the initial state above are those of the ship's reference point. */
+    double lever_b_m[3];          /* reference point -> turntable centre, in b [m]; |r| <= 100 m */
+    double lever_p_m[3];          /* turntable centre -> accelerometer triad, in p [m]; |r| <= 100 m */
+    int32_t coarse_method;        /* enum pyins_coarse_method; 0 = seed 000's TRIAD */
+    int32_t reserved2;            /* padding, ignored; keep 0 */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -234,10 +253,10 @@ typedef struct pyins_output {
     uint32_t fault_flags;         /* bit field, 0 = healthy */
     uint32_t state_flags;         /* enum pyins_state_flag bits */
     int32_t reserved0;
-    double lat_rad;               /* geodetic latitude [rad] */
-    double lon_rad;               /* longitude [rad] */
-    double height_m;              /* height [m] */
-    double vel_n_mps[3];          /* velocity, ENU [m/s] */
+    double lat_rad;               /* geodetic latitude of the reference point [rad] */
+    double lon_rad;               /* longitude of the reference point [rad] */
+    double height_m;              /* height of the reference point [m] */
+    double vel_n_mps[3];          /* velocity of the reference point, ENU [m/s] */
     double quat_nb[4];            /* ship attitude C_b^n as [w, x, y, z], w >= 0 */
     double quat_np[4];            /* IMU attitude C_p^n as [w, x, y, z], w >= 0 */
     double euler_b_rad[3];        /* ship [pitch, roll, yaw] [rad], yaw CCW from North */

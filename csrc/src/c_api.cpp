@@ -41,7 +41,7 @@ int checked(const pyins_core* core, const Firmware** fw) {
 }
 
 constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
-constexpr uint32_t kSnapFormat = 2u;  // 2: sample-level fault state (seq, counters)
+constexpr uint32_t kSnapFormat = 3u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
@@ -335,6 +335,8 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_SATURATION: return "PYINS_E_CONFIG_SATURATION: saturation limits must be positive and finite (0 = default 400 deg/s, 20 g per tick)";
         case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
         case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
+        case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m and lever_p_m must be finite and at most 100 m long";
+        case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD or PYINS_COARSE_FIT";
         case PYINS_W_SEQ_GAP: return "PYINS_W_SEQ_GAP: ticks missing before this sample: bridged (navigation) or alignment restarted; sample taken";
         case PYINS_W_SEQ_REPEAT: return "PYINS_W_SEQ_REPEAT: a sample already taken (seq repeated or behind): dropped, state unchanged";
         case PYINS_W_SEQ_LOST: return "PYINS_W_SEQ_LOST: seq jumped beyond the bridgeable gap: sample taken without bridging, sequence resynchronised";

@@ -39,6 +39,89 @@ Mat3 solve_mat_i_ib0(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Ve
     return ti * tb.transpose();
 }
 
+Vec3 pos_i(double t, double sin_lat, double cos_lat, double gravity) {
+    // (1 - cos x) / x^2 and (x - sin x) / x^3, x = w t, by their Taylor
+    // series: x < 0.2 rad for any alignment the grid can hold at 10 s
+    // outputs, where the first term left out is < 1e-17 of the sum.
+    const double x = earth::kOmegaIe * t;
+    const double x2 = x * x;
+    const double c2 = 0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0 - x2 * (1.0 / 40320.0 - x2 / 3628800.0)));
+    const double s3 = 1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0 - x2 * (1.0 / 362880.0 - x2 / 39916800.0)));
+    const double gt2 = gravity * t * t;
+    return Vec3(cos_lat * gt2 * c2, cos_lat * gt2 * x * s3, sin_lat * 0.5 * gt2);
+}
+
+void fit_weights(double s, double* phi_a, double* phi_b) {
+    // s^2 (1-s)^2 q(s), q by Horner; coefficients exact integers (derived
+    // with rational arithmetic: tools/derive_coarse_fit.py).
+    const double u = s * (1.0 - s);
+    const double w = u * u;
+    *phi_a = w * (45360.0 + s * (-350280.0 + s * (766080.0 - 498960.0 * s)));
+    *phi_b = w * (-27720.0 + s * (221760.0 + s * (-498960.0 + 332640.0 * s)));
+}
+
+Mat3 solve_fit(const Vec3* grid, int32_t n, double t_step, double sin_lat, double cos_lat,
+               double gravity) {
+    // Weighted sums over the grid points k = 0 .. K, s = k / K. The weights
+    // are made exactly orthogonal to 1 and s on this grid, phi' = phi -
+    // (alpha + beta s) with the discrete normal equations, so that the
+    // unknown initial velocity and offset drop out exactly (the continuous
+    // orthogonality alone leaks 2 % of b T at K = 20, falling as K^-4). The
+    // projection is accumulated in the same pass: sum phi' P = sum phi P -
+    // alpha sum P - beta sum s P.
+    const int32_t k_end = n - 1;
+    const double inv_k = 1.0 / static_cast<double>(k_end);
+    Vec3 ia = Vec3::Zero();
+    Vec3 ib = Vec3::Zero();
+    Vec3 ba = Vec3::Zero();
+    Vec3 bb = Vec3::Zero();
+    Vec3 i0 = Vec3::Zero();
+    Vec3 i1 = Vec3::Zero();
+    Vec3 b0 = Vec3::Zero();
+    Vec3 b1 = Vec3::Zero();
+    double a0 = 0.0;   // sum phi_a, sum phi_a s, sum phi_b, sum phi_b s
+    double a1 = 0.0;
+    double c0 = 0.0;
+    double c1 = 0.0;
+    double s1 = 0.0;   // sum s, sum s^2 (sum 1 = n)
+    double s2 = 0.0;
+    for (int32_t k = 0; k <= k_end; ++k) {
+        const double s = static_cast<double>(k) * inv_k;
+        double wa;
+        double wb;
+        fit_weights(s, &wa, &wb);
+        const Vec3 pi = pos_i(static_cast<double>(k) * t_step, sin_lat, cos_lat, gravity);
+        const Vec3& pb = grid[k];
+        ia = ia + wa * pi;
+        ib = ib + wb * pi;
+        ba = ba + wa * pb;
+        bb = bb + wb * pb;
+        i0 = i0 + pi;
+        i1 = i1 + s * pi;
+        b0 = b0 + pb;
+        b1 = b1 + s * pb;
+        a0 = a0 + wa;
+        a1 = a1 + wa * s;
+        c0 = c0 + wb;
+        c1 = c1 + wb * s;
+        s1 = s1 + s;
+        s2 = s2 + s * s;
+    }
+    // [n s1; s1 s2] [alpha; beta] = [sum phi; sum phi s]
+    const double s0 = static_cast<double>(n);
+    const double det = s0 * s2 - s1 * s1;
+    const double alpha_a = (s2 * a0 - s1 * a1) / det;
+    const double beta_a = (s0 * a1 - s1 * a0) / det;
+    const double alpha_b = (s2 * c0 - s1 * c1) / det;
+    const double beta_b = (s0 * c1 - s1 * c0) / det;
+    ia = ia - alpha_a * i0 - beta_a * i1;
+    ib = ib - alpha_b * i0 - beta_b * i1;
+    ba = ba - alpha_a * b0 - beta_a * b1;
+    bb = bb - alpha_b * b0 - beta_b * b1;
+    // anchored on the gravity pair (phi_a), turned about it by the Earth-rate pair
+    return solve_mat_i_ib0(ib, ia, bb, ba);
+}
+
 Mat3 mat_n_e(double sin_lat, double cos_lat) {
     Mat3 m;
     m << 0.0, 1.0, 0.0,
@@ -68,15 +151,18 @@ void init(CoarseAlign& a, const Params& prm) {
     a.hist.dv2 = Vec3::Zero();
     a.hist.count = 0;
     a.tick = 0;
+    a.vel_prev = Vec3::Zero();
+    a.pos_ib0 = Vec3::Zero();
+    a.lever_vel0 = Vec3::Zero();
     for (int i = 0; i < kHistLen; ++i) {
-        a.hist_vel[i] = Vec3::Zero();
+        a.grid[i] = Vec3::Zero();
     }
-    a.hist_count = 1;  // v^ib0(t0) = 0
+    a.hist_count = 1;  // v^ib0(t0) = 0, P^ib0(t0) = 0
     a.mat_i_ib0 = Mat3::Identity();
     a.solved = false;
 }
 
-void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p) {
+void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p) {
     // Velocity and attitude in ib0: dv rotated by C_p^ib0 at the tick start.
     const strapdown::Compensated c = strapdown::compensate(dtheta_p, dv_p, a.hist);
     a.vel_ib0 = a.vel_ib0 + attitude::quat_to_mat(a.quat_ib0_p) * c.dv_p;
@@ -85,12 +171,36 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p) {
     strapdown::push_history(a.hist, dtheta_p, dv_p);
     a.tick = a.tick + 1;
 
+    // The reference point's v^ib0, less the constant u^p(t0) (added back by
+    // TRIAD; a linear term of P that FIT ignores).
+    Vec3 vel = a.vel_ib0;
+    if (a.prm.lever != 0) {
+        vel = vel - attitude::quat_to_mat(a.quat_ib0_p) * lever_vel_p;
+        if (a.tick == 1) {
+            // u^p(t0) from the first sample's rate (its mean over the tick):
+            // off by |w'| dt / 2 |r|, a few mm/s on a swinging ship; FIT does
+            // not need it.
+            a.lever_vel0 = lever_vel_p;
+        }
+    }
+    const bool fit = a.prm.method == static_cast<int32_t>(Method::kFit);
+    if (fit) {
+        a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel);  // trapezoid
+        a.vel_prev = vel;
+    }
+
     const int64_t every = a.prm.output_every;
     if (a.tick % every == 0 && a.hist_count < kHistLen) {
-        a.hist_vel[a.hist_count] = a.vel_ib0;
+        a.grid[a.hist_count] = fit ? a.pos_ib0 : vel;
         a.hist_count = a.hist_count + 1;
     }
     if (a.tick >= a.prm.first_output && (a.tick - a.prm.first_output) % every == 0) {
+        if (fit) {
+            a.mat_i_ib0 = solve_fit(a.grid, a.hist_count, static_cast<double>(every) * a.prm.dt,
+                                    a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity);
+            a.solved = true;
+            return;
+        }
         // t_k1: the history grid point nearest r t_k2, at least one step in,
         // and before t_k2 (both guaranteed by the firmware's config check).
         const double k1_exact = a.prm.ratio * static_cast<double>(a.tick) / static_cast<double>(every);
@@ -106,7 +216,13 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p) {
         const double t2 = static_cast<double>(a.tick) * a.prm.dt;
         const Vec3 vi1 = vel_i(t1, a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity);
         const Vec3 vi2 = vel_i(t2, a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity);
-        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, a.hist_vel[k1], a.vel_ib0);
+        Vec3 vb1 = a.grid[k1];
+        Vec3 vb2 = vel;
+        if (a.prm.lever != 0) {
+            vb1 = vb1 + a.lever_vel0;
+            vb2 = vb2 + a.lever_vel0;
+        }
+        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2);
         a.solved = true;
     }
 }

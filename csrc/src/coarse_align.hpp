@@ -24,6 +24,37 @@
 //   rotation by construction.
 // - The v^ib0 history is kept on a grid of output_every ticks in fixed storage
 //   (kHistLen entries, no heap); t_k1 is the grid point nearest r t_k2.
+//
+// Lever arm: the accelerometers sit at r^p from the ship's reference point
+// (lever_b + the table's sensor offset), so their velocity integral carries
+// the lever velocity, d/dt (C_p^i r^p) = C_p^i u^p with
+// u^p = (w_ip^p - alpha' z) x (Rz(alpha)^T lever_b) + w_ip^p x lever_p
+// (the firmware computes u^p each tick from the gyro and encoder). It
+// integrates exactly to C_p^ib0(t) u^p(t) - u^p(t0), which is removed, so
+// the vectors are the reference point's; no angular acceleration is
+// differentiated from the gyro.
+//
+// Moving base (method FIT). Eq. 4 assumes that the disturbance integrates to
+// zero; a moored ship heaves, surges and sways, and its velocity at t0 is
+// unknown, so the velocity integral carries v_D(t) - v_D(t0): a bounded wave
+// velocity plus an unknown constant. On seed 000's general swing with 0.3 m
+// of surge and sway at 10-12 s and 0.5 m of heave at 8 s, TRIAD is ~160' off
+// in heading at 200 s. FIT integrates once more, P(t) = integral of v dt, so
+// that the disturbance is a bounded displacement plus a linear term
+// -v_D(t0) t + const, and then projects both P^ib0 and P^i on two weight
+// functions of s = t / T that are orthogonal to 1 and s (the unknown initial
+// velocity and offset drop out) and vanish with their slope at both ends
+// (a wave's leakage falls as (w T)^-3):
+//   phi_a(s) = s^2 (1-s)^2 q_a(s), also orthogonal to s^3: picks the t^2
+//              term of gravity, int phi_a s^2 ds = 1;
+//   phi_b(s) = s^2 (1-s)^2 q_b(s), also orthogonal to s^2: picks the t^3
+//              term the Earth's rotation adds (g cos L w t^3 / 6 on y_i),
+//              int phi_b s^3 ds = 1.
+// The two pairs of weighted sums go through the same TRIAD, anchored on the
+// gravity pair. The static-base limit is the same as TRIAD's (the biases
+// enter the t^2 and t^3 terms as in the classical analytic alignment).
+// P^i is closed form: g [cosL (1 - cos wt) / w^2, cosL (wt - sin wt) / w^2,
+// sinL t^2 / 2], by its series (no cancellation, no trigonometry).
 #pragma once
 
 #include <cstdint>
@@ -37,9 +68,18 @@ namespace pyins::coarse_align {
 /// (kHistLen - 1) * output_every ticks (255 s at 1 s outputs).
 inline constexpr int kHistLen = 256;
 
+/// How C_ib0^i is solved (enum pyins_coarse_method).
+enum class Method : int32_t { kTriad = 0, kFit = 1 };
+
+/// FIT needs this many grid intervals at its first output (a polynomial
+/// weight of degree 7 sampled on fewer points is not orthogonal to 1 and s).
+inline constexpr int32_t kFitMinIntervals = 8;
+
 /// Alignment parameters, all durations in ticks.
 struct Params {
-    double ratio;            ///< r = t_k1 / t_k2, in (0, 1)
+    int32_t method;          ///< enum Method
+    int32_t lever;           ///< 1: remove the lever velocity passed to update()
+    double ratio;            ///< r = t_k1 / t_k2, in (0, 1) (TRIAD)
     int32_t first_output;    ///< first attitude solution at this tick
     int32_t output_every;    ///< then every this many ticks; also the history grid
     double dt;               ///< tick period [s]
@@ -54,7 +94,10 @@ struct CoarseAlign {
     Vec3 vel_ib0;            ///< v^ib0 [m/s]
     strapdown::History hist; ///< previous increments (coning, sculling)
     int64_t tick;            ///< samples taken
-    Vec3 hist_vel[kHistLen]; ///< v^ib0 at ticks 0, every, 2 every, ...
+    Vec3 vel_prev;           ///< reference-point v^ib0 (less u^p(t0)) at the last tick (FIT)
+    Vec3 pos_ib0;            ///< its integral [m] (FIT)
+    Vec3 lever_vel0;         ///< u^p(t0) [m/s] (TRIAD)
+    Vec3 grid[kHistLen];     ///< at ticks 0, every, 2 every, ...: v^ib0 (TRIAD) or P^ib0 (FIT)
     int32_t hist_count;
     Mat3 mat_i_ib0;          ///< C_ib0^i of the latest solution
     bool solved;             ///< a solution exists
@@ -70,6 +113,16 @@ Mat3 triad(const Vec3& u, const Vec3& w);
 /// C_ib0^i from v^i and v^ib0 at t_k1 (index 1) and t_k2 (index 2).
 Mat3 solve_mat_i_ib0(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Vec3& vb2);
 
+/// P^i(t) = integral of v^i: the position integral of the specific force (FIT).
+Vec3 pos_i(double t, double sin_lat, double cos_lat, double gravity);
+
+/// The FIT weights phi_a(s), phi_b(s) (see the header comment).
+void fit_weights(double s, double* phi_a, double* phi_b);
+
+/// C_ib0^i by FIT from P^ib0 on the grid points 0 .. n - 1 (spacing t_step [s]).
+Mat3 solve_fit(const Vec3* grid, int32_t n, double t_step, double sin_lat, double cos_lat,
+               double gravity);
+
 /// C_e^n for the e frame whose x axis lies on the site meridian (eq. 2).
 Mat3 mat_n_e(double sin_lat, double cos_lat);
 
@@ -79,8 +132,9 @@ Mat3 mat_e_i(double t);
 /// Start an alignment. Precondition: parameters checked by the firmware.
 void init(CoarseAlign& a, const Params& prm);
 
-/// Take one sample; solves C_ib0^i at the output ticks.
-void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p);
+/// Take one sample; solves C_ib0^i at the output ticks. lever_vel_p: u^p at
+/// the end of the tick [m/s] (read only with prm.lever).
+void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p);
 
 /// C_p^n now. Precondition: a.solved.
 Mat3 mat_n_p(const CoarseAlign& a);

@@ -263,6 +263,19 @@ int config_check(const pyins_config& raw) {
         !(cfg.sat_accel_mps > 0.0) || !std::isfinite(cfg.sat_accel_mps)) {
         return PYINS_E_CONFIG_SATURATION;
     }
+    const double* levers[2] = {cfg.lever_b_m, cfg.lever_p_m};
+    for (const double* r : levers) {
+        if (!finite3(r) || r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > kMaxLeverM * kMaxLeverM) {
+            return PYINS_E_CONFIG_LEVER;
+        }
+    }
+    if (cfg.coarse_method != PYINS_COARSE_TRIAD && cfg.coarse_method != PYINS_COARSE_FIT) {
+        return PYINS_E_CONFIG_COARSE_METHOD;
+    }
+    if (cfg.coarse_method == PYINS_COARSE_FIT && cfg.coarse_ticks > 0 &&
+        cfg.coarse_first_output_ticks / cfg.coarse_output_every_ticks < coarse_align::kFitMinIntervals) {
+        return PYINS_E_CONFIG_ALIGN_EARLY;
+    }
     return PYINS_OK;
 }
 
@@ -286,6 +299,20 @@ void Firmware::init(const pyins_config& raw) {
     last_dtheta_ = Vec3::Zero();
     last_dv_ = Vec3::Zero();
     counts_ = SampleCounts{0u, 0u, 0u, 0u, 0u, 0u, 0u};
+    has_lever_ = 0;
+    for (int i = 0; i < 3; ++i) {
+        if (cfg.lever_b_m[i] != 0.0 || cfg.lever_p_m[i] != 0.0) {
+            has_lever_ = 1;
+        }
+    }
+    rate_count_ = 0;
+    rate_p_ = Vec3::Zero();
+    alpha_rate_ = 0.0;
+    prev_dtheta_ = Vec3::Zero();
+    prev_dalpha_ = 0.0;
+    lever_vel_n_ = Vec3::Zero();
+    lever_refine_ = 0;
+    reserved_lever_ = 0;
 
     // The IMU frame at t0: C_p^n = C_b^n C_p^b = C_b^n Rz(alpha).
     const Vec3 euler_b(cfg.euler_b_rad[0], cfg.euler_b_rad[1], cfg.euler_b_rad[2]);
@@ -304,6 +331,8 @@ void Firmware::init(const pyins_config& raw) {
 
     if (cfg.coarse_ticks > 0) {
         coarse_align::Params prm;
+        prm.method = cfg.coarse_method;
+        prm.lever = has_lever_;
         prm.ratio = cfg.coarse_ratio;
         prm.first_output = cfg.coarse_first_output_ticks;
         prm.output_every = cfg.coarse_output_every_ticks;
@@ -353,6 +382,75 @@ double Firmware::imu_yaw() const {
     return wrap_pi(pmath::atan2(-c01, c11) + encoder_);
 }
 
+void Firmware::update_rates(const Vec3& dtheta_p, double dalpha) {
+    // The increments are means over the tick; the rate at its end is
+    // extrapolated from the last two (second order: the error is
+    // (5/12) w'' dt^2, against w' dt / 2 for the tick's mean alone).
+    if (rate_count_ == 0) {
+        rate_p_ = dtheta_p / dt_;
+        alpha_rate_ = dalpha / dt_;
+    } else {
+        rate_p_ = (1.5 * dtheta_p - 0.5 * prev_dtheta_) / dt_;
+        alpha_rate_ = (1.5 * dalpha - 0.5 * prev_dalpha_) / dt_;
+    }
+    prev_dtheta_ = dtheta_p;
+    prev_dalpha_ = dalpha;
+    if (rate_count_ < 2) {
+        rate_count_ = rate_count_ + 1;
+    }
+}
+
+Vec3 Firmware::lever_p() const {
+    // Rz(alpha)^T lever_b + lever_p, alpha = the encoder angle, from its
+    // cached half-angle (cos a = c^2 - s^2, sin a = 2 s c).
+    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
+    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+    const double* lb = cfg_.lever_b_m;
+    const double* lp = cfg_.lever_p_m;
+    return Vec3(ca * lb[0] + sa * lb[1] + lp[0], -sa * lb[0] + ca * lb[1] + lp[1], lb[2] + lp[2]);
+}
+
+Vec3 Firmware::lever_vel_p() const {
+    // u^p = (w_ip^p - alpha' z) x (Rz^T lever_b) + w_ip^p x lever_p: the table
+    // centre moves with the ship (w_ib, in p), the sensor offset with the IMU.
+    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
+    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+    const double* lb = cfg_.lever_b_m;
+    const Vec3 lb_p(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
+    const Vec3 lp(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
+    const Vec3 w_b = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
+    return attitude::cross(w_b, lb_p) + attitude::cross(rate_p_, lp);
+}
+
+Vec3 Firmware::lever_vel_e_n(const Mat3& mat_np) const {
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
+    const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
+    return mat_np * lever_vel_p() - attitude::cross(w_ie_n, mat_np * lever_p());
+}
+
+void Firmware::place_imu(double lat, double lon, double height, const Vec3& vel_n) {
+    // The accelerometers are at C_p^n r^p from the reference point (ENU
+    // offset d, turned into latitude, longitude and height with the radii
+    // there: second-order terms ~ |d|^2 / R < 1e-6 m for |d| < 100 m).
+    const Mat3 mat_np = attitude::quat_to_mat(sd_.nav.quat_np);
+    const Vec3 d = mat_np * lever_p();
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(lat, &sin_lat, &cos_lat);
+    const earth::PrincipalRadii r = earth::principal_radii(sin_lat);
+    strapdown::NavState& nav = sd_.nav;
+    nav.lat = lat + d(1) / (r.rm + height);
+    nav.lon = wrap_pi(lon + d(0) / ((r.rn + height) * cos_lat));
+    nav.height = height + d(2);
+    nav.vel_n = vel_n + lever_vel_e_n(mat_np);
+    if (sd_.vertical == strapdown::Vertical::kHold) {
+        nav.vel_n(2) = 0.0;
+        sd_.ref_height = nav.height;
+    }
+}
+
 void Firmware::index_reset() {
     if (idx_.state == indexing::State::kFault) {
         indexing::reset(idx_, table_angle_);
@@ -368,6 +466,9 @@ void Firmware::end_coarse() {
     nav.quat_np = attitude::mat_to_quat(coarse_align::mat_n_p(coarse_));
     sd_ = strapdown::make_strapdown(nav, sd_.vertical);
     sd_.hist = coarse_.hist;
+    if (has_lever_ != 0) {
+        place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
+    }
     att_valid_ = true;
     if (cfg_.fine_ticks > 0) {
         start_fine();
@@ -391,6 +492,9 @@ void Firmware::start_fine() {
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
     kf_states_ = cfg_.fine_states;
     fine_tick_ = 0;
+    if (has_lever_ != 0) {
+        lever_vel_n_ = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
+    }
     if (kf_states_ == 8) {
         fine_align::init<8>(fine8_, prm);
     } else {
@@ -410,8 +514,14 @@ void Firmware::apply_fine_correction() {
     // C_p^n = (I + phi x) C_p^n': rotate the attitude by phi^ in n, then
     // phi^ = 0 (the error it described is gone).
     const Vec3 phi = fine_phi();
-    sd_.nav.quat_np = attitude::quat_normalize(
-        attitude::quat_mul(attitude::rotvec_to_quat(phi), sd_.nav.quat_np));
+    const Quat q_phi = attitude::rotvec_to_quat(phi);
+    sd_.nav.quat_np = attitude::quat_normalize(attitude::quat_mul(q_phi, sd_.nav.quat_np));
+    if (has_lever_ != 0) {
+        // the lever velocity in n turns with the attitude: else the next
+        // tick's difference would read phi^ x C u as a specific force (a
+        // feedback loop that turns 1' of heading into 40 ug and diverges)
+        lever_vel_n_ = attitude::quat_to_mat(q_phi) * lever_vel_n_;
+    }
     if (kf_states_ == 8) {
         fine_align::reset_phi<8>(fine8_);
     } else {
@@ -422,6 +532,9 @@ void Firmware::apply_fine_correction() {
 void Firmware::end_fine() {
     // Navigation starts from the corrected attitude (both correction modes).
     apply_fine_correction();
+    if (has_lever_ != 0) {
+        place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
+    }
     start_navigation();
 }
 
@@ -431,6 +544,9 @@ void Firmware::hold_at_site() {
     sd_.nav.height = cfg_.height_m;
     sd_.nav.vel_n = Vec3::Zero();
     sd_.prev_dvel_n = Vec3::Zero();
+    if (has_lever_ != 0) {
+        place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
+    }
 }
 
 void Firmware::reject(uint32_t fault_bit, uint32_t* counter) {
@@ -592,10 +708,43 @@ void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, d
 
 void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     // Unwrap the encoder: the table turns far less than pi per tick.
-    table_angle_ = table_angle_ + wrap_pi(encoder - encoder_);
+    const double dalpha = wrap_pi(encoder - encoder_);
+    table_angle_ = table_angle_ + dalpha;
     if (encoder != encoder_) {  // the table moved: refresh the cached half-angle
         encoder_ = encoder;
         pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
+    }
+    if (has_lever_ != 0) {
+        if (lever_refine_ != 0) {
+            // Navigation started last tick from the configured reference
+            // state with the first tick's mean rate for w(t0); with this
+            // tick's increments w(t0) = (3 dth1 - dth2) / (2 dt): correct the
+            // velocity (and the position it moved) by the difference.
+            lever_refine_ = 0;
+            const Vec3 dw = (prev_dtheta_ - dtheta_p) / (2.0 * dt_);
+            const double dwa = (prev_dalpha_ - dalpha) / (2.0 * dt_);
+            const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
+            const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+            const double* lb = cfg_.lever_b_m;
+            const Vec3 lb_p(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
+            const Vec3 lp(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
+            const Vec3 du = attitude::cross(dw - Vec3(0.0, 0.0, dwa), lb_p) + attitude::cross(dw, lp);
+            Vec3 dvel = attitude::quat_to_mat(sd_.nav.quat_np) * du;
+            if (sd_.vertical == strapdown::Vertical::kHold) {
+                dvel(2) = 0.0;
+            }
+            double sin_lat;
+            double cos_lat;
+            pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
+            const earth::PrincipalRadii r = earth::principal_radii(sin_lat);
+            sd_.nav.vel_n = sd_.nav.vel_n + dvel;
+            sd_.nav.lat = sd_.nav.lat + dvel(1) * dt_ / (r.rm + sd_.nav.height);
+            sd_.nav.lon = wrap_pi(sd_.nav.lon + dvel(0) * dt_ / ((r.rn + sd_.nav.height) * cos_lat));
+            if (sd_.vertical == strapdown::Vertical::kFree) {
+                sd_.nav.height = sd_.nav.height + dvel(2) * dt_;
+            }
+        }
+        update_rates(dtheta_p, dalpha);
     }
     if (gap_pending_) {
         gap_pending_ = false;
@@ -615,17 +764,37 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
             start_fine();
         } else {
             start_navigation();
+            if (has_lever_ != 0) {
+                // the configured state is the reference point's at t0
+                place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m,
+                          Vec3(cfg_.vel_n_mps[0], cfg_.vel_n_mps[1], cfg_.vel_n_mps[2]));
+                lever_refine_ = 1;
+            }
         }
     }
     if (mode_ == Mode::kCoarseAlign) {
-        coarse_align::update(coarse_, dtheta_p, dv_p);
+        coarse_align::update(coarse_, dtheta_p, dv_p,
+                             has_lever_ != 0 ? lever_vel_p() : Vec3::Zero());
         if (coarse_.tick == cfg_.coarse_ticks) {
             end_coarse();
         }
     } else if (mode_ == Mode::kFineAlign) {
         // Attitude by the strapdown; position and velocity held (static base).
-        const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
+        Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
         hold_at_site();
+        if (has_lever_ != 0) {
+            // The lever arm's share of the specific force in n over the
+            // tick, C_p^n (d/dt (C_p^i u^p)) = d/dt (C_p^n u^p) + w_ie^n x
+            // C_p^n u^p at rest: the difference of its velocity telescopes,
+            // so no angular acceleration is taken from the gyro.
+            double sin_lat;
+            double cos_lat;
+            pmath::sincos(cfg_.lat_rad, &sin_lat, &cos_lat);
+            const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
+            const Vec3 lv = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
+            dv_sf_n = dv_sf_n - (lv - lever_vel_n_) - attitude::cross(w_ie_n, lv) * dt_;
+            lever_vel_n_ = lv;
+        }
         bool updated;
         bool healthy;
         if (kf_states_ == 8) {
@@ -667,6 +836,23 @@ void Firmware::output(pyins_output* out) const {
     out->vel_n_mps[0] = nav.vel_n(0);
     out->vel_n_mps[1] = nav.vel_n(1);
     out->vel_n_mps[2] = nav.vel_n(2);
+    if (has_lever_ != 0 && (mode_ == Mode::kFineAlign || mode_ == Mode::kNavigate)) {
+        // The state is the accelerometers'; the record the reference point's.
+        const Mat3 mat_np = attitude::quat_to_mat(nav.quat_np);
+        const Vec3 d = mat_np * lever_p();
+        double sin_lat;
+        double cos_lat;
+        pmath::sincos(nav.lat, &sin_lat, &cos_lat);
+        const earth::PrincipalRadii r = earth::principal_radii(sin_lat);
+        const Vec3 vel = nav.vel_n - lever_vel_e_n(mat_np);
+        out->lat_rad = nav.lat - d(1) / (r.rm + nav.height);
+        out->lon_rad = wrap_pi(nav.lon - d(0) / ((r.rn + nav.height) * cos_lat));
+        out->height_m = nav.height - d(2);
+        out->vel_n_mps[0] = vel(0);
+        out->vel_n_mps[1] = vel(1);
+        // a held vertical channel holds the reference point too
+        out->vel_n_mps[2] = sd_.vertical == strapdown::Vertical::kHold ? 0.0 : vel(2);
+    }
 
     // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
     // measured (encoder) angle: q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)].

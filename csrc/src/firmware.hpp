@@ -62,6 +62,9 @@ inline constexpr int32_t kDefaultSeqMaxGap = 2;
 /// Upper bound of seq_max_gap_ticks: one step call bridges at most this many
 /// ticks (its worst-case run time is that many strapdown updates).
 inline constexpr int32_t kMaxSeqGap = 100;
+/// Longest lever arm accepted [m]: a ship's IMU is metres from its reference
+/// point; beyond 100 m the number is a unit mistake (mm or inches).
+inline constexpr double kMaxLeverM = 100.0;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -149,6 +152,20 @@ class Firmware {
     void start_navigation();
     /// IMU yaw psi_p = psi_b + alpha (DESIGN.md) from the current solution.
     double imu_yaw() const;
+    /// Lever arm (docs/concepts.md, "Lever arms"): rate estimates at the end
+    /// of this tick from its increments and the last tick's.
+    void update_rates(const Vec3& dtheta_p, double dalpha);
+    /// r^p = Rz(alpha)^T lever_b + lever_p: reference point -> accelerometers, in p [m].
+    Vec3 lever_p() const;
+    /// u^p = d/dt (C_p^i r^p) in p: the accelerometers' velocity relative to
+    /// the reference point, inertial derivative [m/s].
+    Vec3 lever_vel_p() const;
+    /// Earth-relative velocity of the accelerometers relative to the
+    /// reference point, in n: C_p^n u^p - w_ie^n x C_p^n r^p [m/s].
+    Vec3 lever_vel_e_n(const Mat3& mat_np) const;
+    /// Put the navigation state on the accelerometers of a reference point
+    /// at (lat, lon, height) moving with vel_n, with the current attitude.
+    void place_imu(double lat, double lon, double height, const Vec3& vel_n);
 
     uint32_t magic_;
     Mode mode_;
@@ -176,6 +193,17 @@ class Firmware {
     Vec3 last_dtheta_;            ///< increments of the last sample taken [rad]
     Vec3 last_dv_;                ///< [m/s]
     SampleCounts counts_;
+    // Lever arm. Set only when one is configured; the state is then the
+    // accelerometers', and the output the reference point's.
+    int32_t has_lever_;           ///< 1: a lever arm is configured
+    int32_t rate_count_;          ///< ticks advanced since init (saturates at 2)
+    Vec3 rate_p_;                 ///< w_ip^p at the end of the last tick [rad/s]
+    double alpha_rate_;           ///< table rate at the end of the last tick [rad/s]
+    Vec3 prev_dtheta_;            ///< angle increment of the last tick advanced [rad]
+    double prev_dalpha_;          ///< table angle change over the last tick advanced [rad]
+    Vec3 lever_vel_n_;            ///< C_p^n u^p at the last fine-alignment tick [m/s]
+    int32_t lever_refine_;        ///< 1: navigation started from the configured state last tick
+    int32_t reserved_lever_;      ///< padding, keep 0
 };
 
 }  // namespace pyins::firmware

@@ -1,7 +1,8 @@
 """Inertial-frame coarse alignment (seed 000), for the IMU frame p.
 
 Mirrors ``csrc/src/coarse_align.{hpp,cpp}``; the header explains the method,
-the sign of eq. 5 and the TRIAD construction that replaces eq. 8.
+the sign of eq. 5, the TRIAD construction that replaces eq. 8, the lever-arm
+velocity it removes and the moving-base method FIT.
 """
 from dataclasses import dataclass, field
 
@@ -11,10 +12,15 @@ from . import attitude, earth, strapdown
 from .attitude import cross
 
 HIST_LEN = 256  #: kHistLen
+METHOD_TRIAD = 0       #: Method::kTriad (PYINS_COARSE_TRIAD)
+METHOD_FIT = 1         #: Method::kFit (PYINS_COARSE_FIT)
+FIT_MIN_INTERVALS = 8  #: kFitMinIntervals
 
 
 @dataclass
 class Params:
+    method: int
+    lever: int
     ratio: float
     first_output: int
     output_every: int
@@ -31,7 +37,10 @@ class CoarseAlign:
     vel_ib0: np.ndarray = field(default_factory=lambda: np.zeros(3))
     hist: strapdown.History = field(default_factory=strapdown.History)
     tick: int = 0
-    hist_vel: list = field(default_factory=lambda: [np.zeros(3)])
+    vel_prev: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    pos_ib0: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    lever_vel0: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    grid: list = field(default_factory=lambda: [np.zeros(3)])
     mat_i_ib0: np.ndarray = field(default_factory=lambda: np.eye(3))
     solved: bool = False
 
@@ -62,6 +71,65 @@ def solve_mat_i_ib0(vi1, vi2, vb1, vb2):
     return ti @ tb.T
 
 
+def pos_i(t, sin_lat, cos_lat, gravity):
+    """P^i(t) = integral of v^i, by the series of (1 - cos x) / x^2 and (x - sin x) / x^3."""
+    x = earth.OMEGA_IE * t
+    x2 = x * x
+    c2 = 0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0 - x2 * (1.0 / 40320.0 - x2 / 3628800.0)))
+    s3 = 1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0 - x2 * (1.0 / 362880.0 - x2 / 39916800.0)))
+    gt2 = gravity * t * t
+    return np.array([cos_lat * gt2 * c2, cos_lat * gt2 * x * s3, sin_lat * 0.5 * gt2])
+
+
+def fit_weights(s):
+    """phi_a(s), phi_b(s) of FIT (coarse_align.hpp; tools/derive_coarse_fit.py)."""
+    u = s * (1.0 - s)
+    w = u * u
+    phi_a = w * (45360.0 + s * (-350280.0 + s * (766080.0 - 498960.0 * s)))
+    phi_b = w * (-27720.0 + s * (221760.0 + s * (-498960.0 + 332640.0 * s)))
+    return phi_a, phi_b
+
+
+def solve_fit(grid, n, t_step, sin_lat, cos_lat, gravity):
+    """C_ib0^i by FIT from P^ib0 on the grid points 0 .. n - 1 (mirrors
+    solve_fit: the weights made exactly orthogonal to 1 and s on the grid)."""
+    k_end = n - 1
+    inv_k = 1.0 / float(k_end)
+    ia, ib, ba, bb = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    i0, i1, b0, b1 = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    a0 = a1 = c0 = c1 = s1 = s2 = 0.0
+    for k in range(0, k_end + 1):
+        s = float(k) * inv_k
+        wa, wb = fit_weights(s)
+        pi = pos_i(float(k) * t_step, sin_lat, cos_lat, gravity)
+        pb = grid[k]
+        ia = ia + wa * pi
+        ib = ib + wb * pi
+        ba = ba + wa * pb
+        bb = bb + wb * pb
+        i0 = i0 + pi
+        i1 = i1 + s * pi
+        b0 = b0 + pb
+        b1 = b1 + s * pb
+        a0 = a0 + wa
+        a1 = a1 + wa * s
+        c0 = c0 + wb
+        c1 = c1 + wb * s
+        s1 = s1 + s
+        s2 = s2 + s * s
+    s0 = float(n)
+    det = s0 * s2 - s1 * s1
+    alpha_a = (s2 * a0 - s1 * a1) / det
+    beta_a = (s0 * a1 - s1 * a0) / det
+    alpha_b = (s2 * c0 - s1 * c1) / det
+    beta_b = (s0 * c1 - s1 * c0) / det
+    ia = ia - alpha_a * i0 - beta_a * i1
+    ib = ib - alpha_b * i0 - beta_b * i1
+    ba = ba - alpha_a * b0 - beta_a * b1
+    bb = bb - alpha_b * b0 - beta_b * b1
+    return solve_mat_i_ib0(ib, ia, bb, ba)
+
+
 def mat_n_e(sin_lat, cos_lat):
     """C_e^n, e's x axis on the site meridian (seed 000 eq. 2)."""
     return np.array([[0.0, 1.0, 0.0], [-sin_lat, 0.0, cos_lat], [cos_lat, 0.0, sin_lat]])
@@ -78,8 +146,11 @@ def init(prm):
     return CoarseAlign(prm=prm)
 
 
-def update(a, dtheta_p, dv_p):
-    """Take one sample; solve C_ib0^i at the output ticks (mirrors update)."""
+def update(a, dtheta_p, dv_p, lever_vel_p=None):
+    """Take one sample; solve C_ib0^i at the output ticks (mirrors update).
+
+    lever_vel_p: u^p at the end of the tick [m/s] (read only with prm.lever).
+    """
     phi, dv_comp = strapdown.compensate(dtheta_p, dv_p, a.hist)
     a.vel_ib0 = a.vel_ib0 + attitude.quat_to_mat(a.quat_ib0_p) @ dv_comp
     a.quat_ib0_p = attitude.quat_normalize(
@@ -87,10 +158,25 @@ def update(a, dtheta_p, dv_p):
     strapdown.push_history(a.hist, dtheta_p, dv_p)
     a.tick = a.tick + 1
 
+    vel = a.vel_ib0
+    if a.prm.lever != 0:
+        vel = vel - attitude.quat_to_mat(a.quat_ib0_p) @ lever_vel_p
+        if a.tick == 1:
+            a.lever_vel0 = np.array(lever_vel_p, dtype=float)
+    fit = a.prm.method == METHOD_FIT
+    if fit:
+        a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel)
+        a.vel_prev = vel.copy()
+
     every = a.prm.output_every
-    if a.tick % every == 0 and len(a.hist_vel) < HIST_LEN:
-        a.hist_vel.append(a.vel_ib0.copy())
+    if a.tick % every == 0 and len(a.grid) < HIST_LEN:
+        a.grid.append(a.pos_ib0.copy() if fit else vel.copy())
     if a.tick >= a.prm.first_output and (a.tick - a.prm.first_output) % every == 0:
+        if fit:
+            a.mat_i_ib0 = solve_fit(a.grid, len(a.grid), float(every) * a.prm.dt,
+                                    a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity)
+            a.solved = True
+            return
         k1 = int(a.prm.ratio * float(a.tick) / float(every) + 0.5)
         k1 = min(k1, (a.tick - 1) // every)
         k1 = max(k1, 1)
@@ -98,7 +184,12 @@ def update(a, dtheta_p, dv_p):
         t2 = float(a.tick) * a.prm.dt
         vi1 = vel_i(t1, a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity)
         vi2 = vel_i(t2, a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity)
-        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, a.hist_vel[k1], a.vel_ib0)
+        vb1 = a.grid[k1]
+        vb2 = vel
+        if a.prm.lever != 0:
+            vb1 = vb1 + a.lever_vel0
+            vb2 = vb2 + a.lever_vel0
+        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2)
         a.solved = True
 
 

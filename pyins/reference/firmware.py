@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from . import attitude, coarse_align, earth, fine_align, indexing, strapdown
+from .attitude import cross
 
 # Status codes: pinned values of enum pyins_status.
 PYINS_OK = 0
@@ -48,6 +49,8 @@ PYINS_E_SAMPLE_SATURATED = -31
 PYINS_E_CONFIG_SATURATION = -32
 PYINS_E_CONFIG_SEQ = -33
 PYINS_E_CONFIG_INDEX_SUMS = -34
+PYINS_E_CONFIG_LEVER = -35
+PYINS_E_CONFIG_COARSE_METHOD = -36
 PYINS_W_SEQ_GAP = 1          #: notices: the sample was handled (docs/core.md)
 PYINS_W_SEQ_REPEAT = 2
 PYINS_W_SEQ_LOST = 3
@@ -110,6 +113,9 @@ COUNTERS = ("n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_
 DEFAULT_TICK_HZ = 100          #: kDefaultTickHz
 MAX_TICK_HZ = 10000            #: kMaxTickHz
 MAX_LAT_RAD = 89.9 * np.pi / 180.0   #: kMaxLatRad
+MAX_LEVER_M = 100.0            #: kMaxLeverM
+COARSE_TRIAD = coarse_align.METHOD_TRIAD   #: PYINS_COARSE_TRIAD
+COARSE_FIT = coarse_align.METHOD_FIT       #: PYINS_COARSE_FIT
 
 TWO_PI = 2.0 * np.pi
 
@@ -156,6 +162,10 @@ def config_default():
         "sat_accel_mps": 0.0,
         "index_sums": indexing.SUMS_STOPS,
         "reserved1": 0,
+        "lever_b_m": np.zeros(3),
+        "lever_p_m": np.zeros(3),
+        "coarse_method": COARSE_TRIAD,
+        "reserved2": 0,
     }
 
 
@@ -299,6 +309,15 @@ def config_check(raw):
     sat = (cfg["sat_gyro_rad"], cfg["sat_accel_mps"])
     if any(not (v > 0.0) or not math.isfinite(v) for v in sat):
         return PYINS_E_CONFIG_SATURATION
+    for r in (cfg["lever_b_m"], cfg["lever_p_m"]):
+        if not _finite3(r) or r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > MAX_LEVER_M * MAX_LEVER_M:
+            return PYINS_E_CONFIG_LEVER
+    if cfg["coarse_method"] not in (COARSE_TRIAD, COARSE_FIT):
+        return PYINS_E_CONFIG_COARSE_METHOD
+    if (cfg["coarse_method"] == COARSE_FIT and cfg["coarse_ticks"] > 0
+            and cfg["coarse_first_output_ticks"] // cfg["coarse_output_every_ticks"]
+            < coarse_align.FIT_MIN_INTERVALS):
+        return PYINS_E_CONFIG_ALIGN_EARLY
     return PYINS_OK
 
 
@@ -370,6 +389,16 @@ class Firmware:
         self.last_dtheta = np.zeros(3)
         self.last_dv = np.zeros(3)
         self.counts = dict.fromkeys(COUNTERS, 0)
+        self.lever_b = np.array(cfg["lever_b_m"], dtype=float)
+        self.lever_pp = np.array(cfg["lever_p_m"], dtype=float)
+        self.has_lever = 1 if (np.any(self.lever_b != 0.0) or np.any(self.lever_pp != 0.0)) else 0
+        self.rate_count = 0
+        self.rate_p = np.zeros(3)
+        self.alpha_rate = 0.0
+        self.prev_dtheta = np.zeros(3)
+        self.prev_dalpha = 0.0
+        self.lever_vel_n = np.zeros(3)
+        self.lever_refine = 0
         euler_b = np.array(cfg["euler_b_rad"], dtype=float)
         mat_np = attitude.euler_to_mat(euler_b) @ attitude.rot_z(self.encoder)
         lon = cfg["lon_rad"]
@@ -395,7 +424,7 @@ class Firmware:
         if cfg["coarse_ticks"] > 0:
             sin_lat, cos_lat = np.sin(cfg["lat_rad"]), np.cos(cfg["lat_rad"])
             prm = coarse_align.Params(
-                ratio=cfg["coarse_ratio"], first_output=cfg["coarse_first_output_ticks"],
+                method=cfg["coarse_method"], lever=self.has_lever, ratio=cfg["coarse_ratio"], first_output=cfg["coarse_first_output_ticks"],
                 output_every=cfg["coarse_output_every_ticks"], dt=self.dt, sin_lat=sin_lat,
                 cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]))
             self.coarse = coarse_align.init(prm)
@@ -407,6 +436,8 @@ class Firmware:
                                  attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse)))
         self.sd = strapdown.make_strapdown(nav, self.sd.vertical)
         self.sd.hist = self.coarse.hist
+        if self.has_lever:
+            self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
         self.att_valid = True
         if self.cfg["fine_ticks"] > 0:
             self.start_fine()
@@ -423,6 +454,8 @@ class Firmware:
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
         self.kf_states = cfg["fine_states"]
         self.fine_tick = 0
+        if self.has_lever:
+            self.lever_vel_n = attitude.quat_to_mat(self.sd.nav.quat_np) @ self.lever_vel_p()
         self.fine = fine_align.init(self.kf_states, prm)
         self.mode = MODE_FINE_ALIGN
 
@@ -434,12 +467,17 @@ class Firmware:
     def apply_fine_correction(self):
         """C_p^n = (I + phi x) C_p^n': rotate by phi^ in n, then phi^ = 0."""
         phi = self.fine_phi()
-        self.sd.nav.quat_np = attitude.quat_normalize(
-            attitude.quat_mul(attitude.rotvec_to_quat(phi), self.sd.nav.quat_np))
+        q_phi = attitude.rotvec_to_quat(phi)
+        self.sd.nav.quat_np = attitude.quat_normalize(attitude.quat_mul(q_phi, self.sd.nav.quat_np))
+        if self.has_lever:
+            # the lever velocity in n turns with the attitude (see firmware.cpp)
+            self.lever_vel_n = attitude.quat_to_mat(q_phi) @ self.lever_vel_n
         fine_align.reset_phi(self.fine)
 
     def end_fine(self):
         self.apply_fine_correction()
+        if self.has_lever:
+            self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
         self.start_navigation()
 
     def start_navigation(self):
@@ -454,6 +492,56 @@ class Firmware:
         c11 = w * w - x * x + y * y - z * z
         return wrap_pi(np.arctan2(-c01, c11) + self.encoder)
 
+    def update_rates(self, dtheta_p, dalpha):
+        """Rates at the end of the tick, second order (mirrors update_rates)."""
+        if self.rate_count == 0:
+            self.rate_p = dtheta_p / self.dt
+            self.alpha_rate = dalpha / self.dt
+        else:
+            self.rate_p = (1.5 * dtheta_p - 0.5 * self.prev_dtheta) / self.dt
+            self.alpha_rate = (1.5 * dalpha - 0.5 * self.prev_dalpha) / self.dt
+        self.prev_dtheta = np.array(dtheta_p, dtype=float)
+        self.prev_dalpha = dalpha
+        if self.rate_count < 2:
+            self.rate_count = self.rate_count + 1
+
+    def _lever_b_p(self):
+        """Rz(alpha)^T lever_b from the cached half-angle."""
+        sa = 2.0 * self.enc_sin_half * self.enc_cos_half
+        ca = self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half
+        lb = self.lever_b
+        return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
+
+    def lever_p(self):
+        """r^p = Rz(alpha)^T lever_b + lever_p (mirrors Firmware::lever_p)."""
+        return self._lever_b_p() + self.lever_pp
+
+    def lever_vel_p(self):
+        """u^p = (w_ip^p - alpha' z) x Rz^T lever_b + w_ip^p x lever_p (mirrors lever_vel_p)."""
+        w_b = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
+        return cross(w_b, self._lever_b_p()) + cross(self.rate_p, self.lever_pp)
+
+    def lever_vel_e_n(self, mat_np):
+        """C_p^n u^p - w_ie^n x C_p^n r^p (mirrors lever_vel_e_n)."""
+        lat = self.sd.nav.lat
+        w_ie_n = np.array([0.0, earth.OMEGA_IE * np.cos(lat), earth.OMEGA_IE * np.sin(lat)])
+        return mat_np @ self.lever_vel_p() - cross(w_ie_n, mat_np @ self.lever_p())
+
+    def place_imu(self, lat, lon, height, vel_n):
+        """The navigation state on the accelerometers of a reference point (mirrors place_imu)."""
+        mat_np = attitude.quat_to_mat(self.sd.nav.quat_np)
+        d = mat_np @ self.lever_p()
+        sin_lat, cos_lat = np.sin(lat), np.cos(lat)
+        rm, rn = earth.principal_radii(sin_lat)
+        nav = self.sd.nav
+        nav.lat = lat + d[1] / (rm + height)
+        nav.lon = wrap_pi(lon + d[0] / ((rn + height) * cos_lat))
+        nav.height = height + d[2]
+        nav.vel_n = np.array(vel_n, dtype=float) + self.lever_vel_e_n(mat_np)
+        if self.sd.vertical == strapdown.VERTICAL_HOLD:
+            nav.vel_n[2] = 0.0
+            self.sd.ref_height = nav.height
+
     def index_reset(self):
         if self.idx.state == indexing.STATE_FAULT:
             self.idx = indexing.reset(self.idx, self.table_angle)
@@ -464,6 +552,8 @@ class Firmware:
         self.sd.nav.height = self.cfg["height_m"]
         self.sd.nav.vel_n = np.zeros(3)
         self.sd.prev_dvel_n = np.zeros(3)
+        if self.has_lever:
+            self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
 
     def reject(self, fault_bit, counter):
         """A rejected sample: sticky bit, counter, alignment restart (mirrors reject)."""
@@ -568,11 +658,31 @@ class Firmware:
 
     def advance(self, dtheta_p, dv_p, encoder):
         """One tick with increments taken as good (mirrors Firmware::advance)."""
-        self.table_angle = self.table_angle + wrap_pi(encoder - self.encoder)
+        dalpha = wrap_pi(encoder - self.encoder)
+        self.table_angle = self.table_angle + dalpha
         if encoder != self.encoder:   # the table moved: refresh the cached half-angle
             self.encoder = encoder
             self.enc_sin_half = math.sin(0.5 * self.encoder)
             self.enc_cos_half = math.cos(0.5 * self.encoder)
+        if self.has_lever:
+            if self.lever_refine:
+                # w(t0) refined with this tick's increments (mirrors advance)
+                self.lever_refine = 0
+                dw = (self.prev_dtheta - dtheta_p) / (2.0 * self.dt)
+                dwa = (self.prev_dalpha - dalpha) / (2.0 * self.dt)
+                du = cross(dw - np.array([0.0, 0.0, dwa]), self._lever_b_p()) + cross(dw, self.lever_pp)
+                dvel = attitude.quat_to_mat(self.sd.nav.quat_np) @ du
+                if self.sd.vertical == strapdown.VERTICAL_HOLD:
+                    dvel[2] = 0.0
+                nav = self.sd.nav
+                sin_lat, cos_lat = np.sin(nav.lat), np.cos(nav.lat)
+                rm, rn = earth.principal_radii(sin_lat)
+                nav.vel_n = nav.vel_n + dvel
+                nav.lat = nav.lat + dvel[1] * self.dt / (rm + nav.height)
+                nav.lon = wrap_pi(nav.lon + dvel[0] * self.dt / ((rn + nav.height) * cos_lat))
+                if self.sd.vertical == strapdown.VERTICAL_FREE:
+                    nav.height = nav.height + dvel[2] * self.dt
+            self.update_rates(dtheta_p, dalpha)
         if self.gap_pending:
             self.gap_pending = False
             self.align_restarts = self.align_restarts + 1
@@ -589,13 +699,24 @@ class Firmware:
                 self.start_fine()
             else:
                 self.start_navigation()
+                if self.has_lever:
+                    self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"],
+                                   np.array(self.cfg["vel_n_mps"], dtype=float))
+                    self.lever_refine = 1
         if self.mode == MODE_COARSE_ALIGN:
-            coarse_align.update(self.coarse, dtheta_p, dv_p)
+            coarse_align.update(self.coarse, dtheta_p, dv_p,
+                                self.lever_vel_p() if self.has_lever else np.zeros(3))
             if self.coarse.tick == self.cfg["coarse_ticks"]:
                 self.end_coarse()
         elif self.mode == MODE_FINE_ALIGN:
             dv_sf_n = strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
             self.hold_at_site()
+            if self.has_lever:
+                lat = self.cfg["lat_rad"]
+                w_ie_n = np.array([0.0, earth.OMEGA_IE * np.cos(lat), earth.OMEGA_IE * np.sin(lat)])
+                lv = attitude.quat_to_mat(self.sd.nav.quat_np) @ self.lever_vel_p()
+                dv_sf_n = dv_sf_n - (lv - self.lever_vel_n) - cross(w_ie_n, lv) * self.dt
+                self.lever_vel_n = lv
             updated = fine_align.step(self.fine, dv_sf_n)
             if not self.fine.healthy:
                 self.faults = self.faults | FAULT_KF_NOT_PD
@@ -623,15 +744,27 @@ class Firmware:
                 attitude.quat_mul(attitude.rotvec_to_quat(self.fine_phi()), nav.quat_np))
         q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
+        lat, lon, height, vel = nav.lat, nav.lon, nav.height, nav.vel_n.copy()
+        if self.has_lever and self.mode in (MODE_FINE_ALIGN, MODE_NAVIGATE):
+            mat_np = attitude.quat_to_mat(nav.quat_np)
+            d = mat_np @ self.lever_p()
+            sin_lat, cos_lat = np.sin(nav.lat), np.cos(nav.lat)
+            rm, rn = earth.principal_radii(sin_lat)
+            vel = nav.vel_n - self.lever_vel_e_n(mat_np)
+            lat = nav.lat - d[1] / (rm + nav.height)
+            lon = wrap_pi(nav.lon - d[0] / ((rn + nav.height) * cos_lat))
+            height = nav.height - d[2]
+            if self.sd.vertical == strapdown.VERTICAL_HOLD:
+                vel[2] = 0.0
         return {
             "tick": self.tick,
             "mode": self.mode,
             "fault_flags": self.faults,
             "state_flags": STATE_ATT_VALID if valid else 0,
-            "lat_rad": nav.lat,
-            "lon_rad": nav.lon,
-            "height_m": nav.height,
-            "vel_n_mps": nav.vel_n.copy(),
+            "lat_rad": lat,
+            "lon_rad": lon,
+            "height_m": height,
+            "vel_n_mps": vel,
             "quat_nb": q_nb,
             "quat_np": q_np.copy(),
             "euler_b_rad": euler_b,

@@ -3,6 +3,10 @@
 - `pyins.sim.motion`: analytic motion profiles (`Static`, `Swing` and the
   seed 000 sea states, `HeadingSwing` of seed 002, `Manoeuvre`) and turntable
   profiles (`Fixed`, `ConstantRate`).
+- `pyins.sim.ship`: a real ship at the pier: heave, surge and sway
+  (`LinearMotion`), lever arms (`ShipAtSea`), wave spectra
+  (`sea_spectrum_motion`, `SEA_STATE_SPECTRA`) and the built-in moored ship
+  (`moored`, `MOORED_SHIP`).
 - `pyins.sim.imu`: exact per-tick increments by Gauss-Legendre quadrature of
   the body rate and specific force (`exact_increments`), the true state at the
   sample instants (`truth`), and a chunked run generator (`generate`).
@@ -23,6 +27,9 @@ from pyins.sim.motion import (SEA_STATES, ConstantRate, Fixed, HeadingSwing, Man
                               MotionState, Segment, Static, Swing, TableMotion, default_segments,
                               sea_state)
 from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
+from pyins.sim.ship import (MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, dnv_gamma,
+                            heave_response, jonswap, moored, named_sea_spectrum,
+                            nb_rate_and_derivative, pierson_moskowitz, sea_spectrum_motion)
 
 __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
@@ -31,4 +38,7 @@ __all__ = [
     "SEA_STATES", "ConstantRate", "Fixed", "HeadingSwing", "Manoeuvre", "Motion",
     "MotionState", "Segment", "Static", "Swing", "TableMotion", "default_segments", "sea_state",
     "PRESETS", "SensorErrors", "SensorModel", "preset",
+    "MOORED_SHIP", "SEA_STATE_SPECTRA", "LinearMotion", "ShipAtSea", "dnv_gamma", "heave_response",
+    "jonswap", "moored", "named_sea_spectrum", "nb_rate_and_derivative", "pierson_moskowitz",
+    "sea_spectrum_motion",
 ]

@@ -35,6 +35,11 @@ The Earth model is ``pyins.reference.earth``, shared with the firmware.
 Everything is element-wise in NumPy (no BLAS, no pairwise sums), so computing
 a run in chunks gives bit-identical results to one call.
 
+For a `pyins.sim.ship.ShipAtSea` the state is that of the IMU point (lever
+arms and heave, surge, sway included: its vel_n and acc_n are exact), so the
+same formulas give the increments at the sensor; `truth` reports the motion
+reference point beside it (``imu_*`` fields).
+
 Ticks and samples: tick interval k (0-based) ends at t0 + (k + 1) dt; its
 sample carries the tick number k + 1 (DESIGN.md section 3: the increment over
 [t_{k-1}, t_k] and the encoder angle at t_k). `truth` is the state at the
@@ -203,13 +208,22 @@ def _to_p(omega_b, force_b, alpha, alpha_dot):
 # ---------------------------------------------------------------------------
 # Increments
 # ---------------------------------------------------------------------------
+def _state(motion, t_hi, t_lo, table):
+    """The motion's state at the IMU point: a motion whose IMU point moves with
+    the table (`pyins.sim.ship.ShipAtSea` with a non-zero lever_p,
+    ``needs_table``) is given the table; every other motion is not."""
+    if getattr(motion, "needs_table", False):
+        return motion.state(t_hi, t_lo, table=table)
+    return motion.state(t_hi, t_lo)
+
+
 def _increments_block(motion, ticks, dt, t0, table, x, w):
     m = len(x)
     n = len(ticks)
     s = 0.5 * (1.0 + x)
     t_hi, t_lo = split_times(ticks[:, None], dt, t0, s[None, :])
     t_hi, t_lo = t_hi.ravel(), t_lo.ravel()
-    st = motion.state(t_hi, t_lo)
+    st = _state(motion, t_hi, t_lo, table)
     omega, force = body_rate_and_force(st)
     if table is not None:
         alpha, alpha_dot = table.state(t_hi, t_lo)
@@ -230,8 +244,13 @@ def node_rates(motion, ticks, dt=0.01, t0=0.0, nodes=5):
 
     Returns ``(omega (n, nodes, 3), force (n, nodes, 3), x, w)`` with x, w the
     abscissae on [-1, 1] and weights: what the firmware-in-the-loop plant
-    (pyins_plant.h) integrates after turning them into the IMU frame.
+    (pyins_plant.h) integrates after turning them into the IMU frame. A lever
+    arm in b (``ShipAtSea.lever_b``) is already in the force at the IMU
+    point; a sensor offset that turns with the table (``lever_p``) is not
+    representable (the plant turns b-frame values into p) and is refused.
     """
+    if getattr(motion, "needs_table", False):
+        raise ValueError("lever_p is not supported by the compiled FIL plant yet; use lever_b")
     x, w = np.polynomial.legendre.leggauss(nodes)
     ticks = np.asarray(ticks, dtype=np.int64)
     s = 0.5 * (1.0 + x)
@@ -283,7 +302,8 @@ def exact_increments(motion, n_ticks, dt=0.01, t0=0.0, table=None, nodes=5, star
     n_ticks = int(n_ticks)
     x, w = leggauss(int(nodes))
     ticks = np.arange(start_tick, start_tick + n_ticks, dtype=np.int64)
-    constant = isinstance(motion, Static) and (table is None or isinstance(table, Fixed))
+    constant = ((isinstance(motion, Static) or getattr(motion, "is_constant", False))
+                and (table is None or isinstance(table, Fixed)))
     if constant and n_ticks > 0:
         # Fast path: the integrand does not depend on time, so every tick
         # equals the first one (computed by the generic code, so the two
@@ -305,16 +325,33 @@ def exact_increments(motion, n_ticks, dt=0.01, t0=0.0, table=None, nodes=5, star
 # ---------------------------------------------------------------------------
 @dataclass
 class Truth:
-    """True state at the END of each tick (the sample instants)."""
+    """True state at the END of each tick (the sample instants).
+
+    ``lat``, ``lon``, ``height`` and ``vel_n`` are those of the ship's motion
+    reference point (what the firmware reports once it knows the lever arm);
+    the ``imu_*`` fields those of the IMU point, where the increments are
+    measured. They differ only for a `pyins.sim.ship.ShipAtSea` with a lever
+    arm; otherwise they are equal bit for bit (left None, they are filled in
+    as copies of the reference fields).
+    """
     tick: np.ndarray        #: tick number k + 1 of each sample, (N,) int64
     time: np.ndarray        #: profile time t0 + tick dt [s] (rounded), (N,)
-    lat: np.ndarray         #: [rad], (N,)
-    lon: np.ndarray         #: [rad], (N,)
-    height: np.ndarray      #: [m], (N,)
-    vel_n: np.ndarray       #: [m/s], (N, 3)
+    lat: np.ndarray         #: reference point [rad], (N,)
+    lon: np.ndarray         #: reference point [rad], (N,)
+    height: np.ndarray      #: reference point [m], (N,)
+    vel_n: np.ndarray       #: reference point [m/s], (N, 3)
     quat_nb: np.ndarray     #: C_b^n as [w, x, y, z], w >= 0, (N, 4)
     euler: np.ndarray       #: [pitch, roll, yaw] [rad], yaw in (-pi, pi], (N, 3)
     table_angle: np.ndarray  #: [rad] in [0, 2 pi), (N,)
+    imu_lat: np.ndarray = None      #: IMU point [rad], (N,)
+    imu_lon: np.ndarray = None      #: IMU point [rad], (N,)
+    imu_height: np.ndarray = None   #: IMU point [m], (N,)
+    imu_vel_n: np.ndarray = None    #: IMU point [m/s], (N, 3)
+
+    def __post_init__(self):
+        for name in ("lat", "lon", "height", "vel_n"):
+            if getattr(self, "imu_" + name) is None:
+                setattr(self, "imu_" + name, np.array(getattr(self, name), copy=True))
 
 
 def truth(motion, n_ticks, dt=0.01, t0=0.0, table=None, start_tick=0):
@@ -334,12 +371,15 @@ def truth_at(motion, sample_ticks, dt=0.01, t0=0.0, table=None):
     """
     ticks = np.asarray(sample_ticks, dtype=np.int64) - 1
     t_hi, t_lo = split_times(ticks + 1, dt, t0)
-    st = motion.state(t_hi, t_lo)
+    st = _state(motion, t_hi, t_lo, table)
+    ref = motion.reference_state(t_hi, t_lo) if hasattr(motion, "reference_state") else st
     euler = st.euler.copy()
     euler[:, 2] = wrap_pi(euler[:, 2])
-    return Truth(tick=ticks + 1, time=t_hi + t_lo, lat=st.lat, lon=st.lon,
-                 height=st.height, vel_n=st.vel_n, quat_nb=euler_to_quat(st.euler),
-                 euler=euler, table_angle=_table_angle_end(table, ticks, dt, t0))
+    return Truth(tick=ticks + 1, time=t_hi + t_lo, lat=ref.lat, lon=ref.lon,
+                 height=ref.height, vel_n=ref.vel_n, quat_nb=euler_to_quat(st.euler),
+                 euler=euler, table_angle=_table_angle_end(table, ticks, dt, t0),
+                 imu_lat=st.lat.copy(), imu_lon=st.lon.copy(), imu_height=st.height.copy(),
+                 imu_vel_n=st.vel_n.copy())
 
 
 # ---------------------------------------------------------------------------

@@ -181,6 +181,11 @@ class Static(Motion):
         return MotionState(lat, lon, h, zeros, zeros.copy(),
                            np.tile(self.euler0, (n, 1)), zeros.copy())
 
+    def euler_accel(self, t, t_lo=None):
+        """Second derivative of the Euler angles [rad/s^2], (N, 3): zero."""
+        t, _ = _times(t, t_lo)
+        return np.zeros((t.shape[0], 3))
+
 
 class Swing(Motion):
     """Ship at a fixed position swinging sinusoidally on all three Euler angles.
@@ -229,6 +234,20 @@ class Swing(Motion):
         lat, lon, h = _fixed_position(self, n)
         zeros = np.zeros((n, 3))
         return MotionState(lat, lon, h, zeros, zeros.copy(), euler, rate)
+
+    def euler_accel(self, t, t_lo=None):
+        """Second derivative of the Euler angles [rad/s^2], (N, 3).
+
+        ``-amplitude (2 pi f)^2 sin(phase)``, the phase formed exactly as in
+        `state` (so HeadingSwing gets ``-A (2 pi / T) sin(2 pi t / T)``).
+        """
+        t, t_lo = _times(t, t_lo)
+        acc = np.empty((t.shape[0], 3))
+        for j in range(3):
+            phase = TWO_PI * frac_cycles(self.frequency_hz[j], t, t_lo) + self.phase[j]
+            omega = TWO_PI * self.frequency_hz[j]
+            acc[:, j] = -(self.amplitude[j] * omega * omega) * np.sin(phase)
+        return acc
 
 
 #: Seed 000 Table 2, the three-axis turntable swing profiles:
@@ -629,11 +648,18 @@ class TableMotion:
 
     alpha is the table angle [rad] (C_p^b = Rz(alpha), counter-clockwise seen
     from above), alpha_dot its rate [rad/s]. alpha may be returned reduced by
-    whole turns; callers wrap it.
+    whole turns; callers wrap it. ``state3`` adds the exact angular
+    acceleration [rad/s^2], needed when the accelerometer triad sits off the
+    table axis (``lever_p`` of `pyins.sim.ship.ShipAtSea`).
     """
 
     def state(self, t, t_lo=None):
         raise NotImplementedError
+
+    def state3(self, t, t_lo=None):
+        """``(alpha, alpha_dot, alpha_ddot)`` at the times, each (N,)."""
+        raise NotImplementedError(f"{type(self).__name__} gives no angular acceleration "
+                                  f"(state3), which a rotating lever_p needs")
 
 
 class Fixed(TableMotion):
@@ -645,6 +671,10 @@ class Fixed(TableMotion):
     def state(self, t, t_lo=None):
         t, _ = _times(t, t_lo)
         return np.full(t.shape, self.alpha0), np.zeros(t.shape)
+
+    def state3(self, t, t_lo=None):
+        alpha, rate = self.state(t, t_lo)
+        return alpha, rate, np.zeros(alpha.shape)
 
 
 class ConstantRate(TableMotion):
@@ -663,3 +693,7 @@ class ConstantRate(TableMotion):
         t, t_lo = _times(t, t_lo)
         alpha = self.alpha0 + TWO_PI * frac_cycles(self._cycles_per_s, t, t_lo)
         return alpha, np.full(t.shape, self.rate)
+
+    def state3(self, t, t_lo=None):
+        alpha, rate = self.state(t, t_lo)
+        return alpha, rate, np.zeros(alpha.shape)

@@ -95,7 +95,7 @@ int main(void) {
                              PYINS_E_CONFIG_INDEX_STEP, PYINS_E_SNAPSHOT_SIZE,
                              PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT,
                              PYINS_E_SAMPLE_SATURATED, PYINS_E_CONFIG_SATURATION, PYINS_E_CONFIG_SEQ,
-                             PYINS_E_CONFIG_INDEX_SUMS,
+                             PYINS_E_CONFIG_INDEX_SUMS, PYINS_E_CONFIG_LEVER, PYINS_E_CONFIG_COARSE_METHOD,
                              PYINS_W_SEQ_GAP, PYINS_W_SEQ_REPEAT, PYINS_W_SEQ_LOST, PYINS_W_ENCODER_JUMP};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
@@ -116,6 +116,7 @@ int main(void) {
               PYINS_E_CONFIG_LAT == -11 && PYINS_E_CONFIG_MODE == -16, "pinned status values");
         check(PYINS_E_SNAPSHOT_CORRUPT == -30 && PYINS_E_SAMPLE_SATURATED == -31 &&
               PYINS_E_CONFIG_SATURATION == -32 && PYINS_E_CONFIG_SEQ == -33 && PYINS_E_CONFIG_INDEX_SUMS == -34 &&
+              PYINS_E_CONFIG_LEVER == -35 && PYINS_E_CONFIG_COARSE_METHOD == -36 &&
               PYINS_W_SEQ_GAP == 1 &&
               PYINS_W_SEQ_REPEAT == 2 && PYINS_W_SEQ_LOST == 3 && PYINS_W_ENCODER_JUMP == 4,
               "pinned sample-level status values");
@@ -208,6 +209,27 @@ int main(void) {
     BAD_CFG(b.sat_gyro_rad = NAN, PYINS_E_CONFIG_SATURATION, "NaN gyro saturation");
     BAD_CFG(b.sat_accel_mps = INFINITY, PYINS_E_CONFIG_SATURATION, "Inf accel saturation");
     BAD_CFG(b.sat_accel_mps = -1.0, PYINS_E_CONFIG_SATURATION, "negative accel saturation");
+    BAD_CFG(b.lever_b_m[1] = NAN, PYINS_E_CONFIG_LEVER, "NaN lever arm");
+    BAD_CFG(b.lever_p_m[2] = INFINITY, PYINS_E_CONFIG_LEVER, "Inf sensor offset");
+    BAD_CFG((b.lever_b_m[0] = 60.0, b.lever_b_m[1] = 60.0, b.lever_b_m[2] = 60.0), PYINS_E_CONFIG_LEVER,
+            "lever arm of 104 m (60 m per axis)");
+    BAD_CFG(b.lever_p_m[0] = -100.5, PYINS_E_CONFIG_LEVER, "sensor offset longer than 100 m");
+    {
+        /* 98.5 m and exactly 100 m are accepted */
+        pyins_config g;
+        pyins_config_default(&g);
+        g.lever_b_m[0] = 60.0;
+        g.lever_b_m[1] = 60.0;
+        g.lever_b_m[2] = 50.0;
+        check_status(pyins_config_check(&g), PYINS_OK, "lever arm of 98.5 m accepted");
+        pyins_config_default(&g);
+        g.lever_p_m[2] = -100.0;
+        check_status(pyins_config_check(&g), PYINS_OK, "sensor offset of exactly 100 m accepted");
+    }
+    BAD_CFG(b.coarse_method = 2, PYINS_E_CONFIG_COARSE_METHOD, "unknown coarse method");
+    BAD_CFG(b.coarse_method = -1, PYINS_E_CONFIG_COARSE_METHOD, "negative coarse method");
+    BAD_CFG((b.coarse_method = PYINS_COARSE_FIT, b.coarse_ticks = 3000, b.coarse_first_output_ticks = 700),
+            PYINS_E_CONFIG_ALIGN_EARLY, "FIT with fewer than 8 grid intervals at its first output");
     {
         pyins_config g;
         pyins_config_default(&g);
