@@ -1163,6 +1163,7 @@ def _markdown(camp, result, rows):
             continue
         unit, scale = _display_unit(m, [r[2].get(m) for r in rows])
         lines += [f"### {m} [{unit}]", "", info["meaning"] + ".", ""]
+        lines += _pivot_lines(camp, sel, scale)
         heads = ["group"] + (["variant"] if vcol else []) + list(STATS)
         lines += ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
         for a in sel:
@@ -1171,6 +1172,98 @@ def _markdown(camp, result, rows):
                 + " |")
         lines.append("")
     return "\n".join(lines)
+
+
+def _group_value_label(camp, key, value):
+    """A group's value of ``key`` as text ("heave 0.5 m", "run 2")."""
+    return f"run {value}" if key == "seed" else _value_label(camp.labels, key, value, camp.grid)
+
+
+def _by_key(camp, key):
+    """The groups arranged against one group key: (x labels, lines) with
+    lines = [(label of the other keys' values, {x index: group index})], both
+    in the order the groups come (grid order)."""
+    others = [k for k in camp.group_by if k != key]
+    xs, lines = {}, {}
+    for gi, g in enumerate(camp.groups):
+        vals = g["values"]
+        x = xs.setdefault(_canonical(vals[key]), (len(xs), _group_value_label(camp, key, vals[key])))[0]
+        line = tuple(_canonical(vals[k]) for k in others)
+        if line not in lines:
+            lines[line] = (", ".join(_group_value_label(camp, k, vals[k]) for k in others), {})
+        lines[line][1][x] = gi
+    return [label for _, label in sorted(xs.values())], list(lines.values())
+
+
+def _pivot_lines(camp, sel, scale):
+    """With two or more group keys: the mean of each group in a table whose
+    rows are the first key's values and whose columns are the others' (per
+    [compare] variant)."""
+    if len(camp.group_by) < 2:
+        return []
+    rows, cols = _by_key(camp, camp.group_by[0])
+    out = []
+    for v in camp.variants or [None]:
+        mean = {a["group"]: a["mean"] for a in sel if a["variant"] == v}
+        out += [f"Mean over the runs of each group, by {camp.group_by[0]} (rows) and "
+                f"{', '.join(camp.group_by[1:])} (columns)" + (f", {v}" if v else "") + ":", "",
+                "| " + " | ".join([""] + [label for label, _ in cols]) + " |",
+                "|" + "---|" * (len(cols) + 1)]
+        for xi, row in enumerate(rows):
+            out.append("| " + " | ".join([row] + [_g(mean.get(groups.get(xi)), scale)
+                                                 for _, groups in cols]) + " |")
+        out.append("")
+    return out
+
+
+def _by_key_plots(camp, pdir, result, rows, plt):
+    """With two or more group keys: per metric, plots/<metric>_by_keys.png,
+    the mean +- std of each group against the first group key (left) and the
+    second (right), one line per value of the other keys."""
+    written = []
+    if len(camp.group_by) < 2:
+        return written
+    keys = camp.group_by[:2]
+    vlabels = camp.variants or [None]
+    for si, info in result["metrics"].items():
+        m = info["metric"]
+        vals_all = [r[2][m] for r in rows if m in r[2]]
+        if m in GROUP_METRICS or not vals_all or not any(vals_all):
+            continue
+        unit, scale = _display_unit(m, vals_all)
+        fig, axes = plt.subplots(1, 2, figsize=(12.0, 5.2), sharey=True)
+        for ax, key in zip(axes, keys):
+            xlabels, lines = _by_key(camp, key)
+            n = len(lines) * len(vlabels)
+            step = 0.3 / max(n - 1, 1)            # the lines side by side, each error bar visible
+            k = 0
+            for line_label, groups in lines:
+                for v in vlabels:
+                    agg = {a["group"]: a for a in result["aggregates"]
+                           if a["metric"] == si and a["variant"] == v}
+                    xs = [x for x in sorted(groups) if groups[x] in agg]
+                    off = (k - (n - 1) / 2) * step if n > 1 else 0.0
+                    ax.errorbar(np.array(xs, dtype=float) + off,
+                                [agg[groups[x]]["mean"] / scale for x in xs],
+                                yerr=[(agg[groups[x]]["std"] or 0.0) / scale for x in xs],
+                                fmt="o-", ms=4, lw=1, capsize=3,
+                                label=line_label + (f" [{v}]" if v else ""))
+                    k += 1
+            ax.set_xticks(np.arange(len(xlabels)), xlabels, fontsize=8)
+            ax.set_xlabel(key, fontsize=9)
+            ax.grid(alpha=0.3)
+            ax.set_title(f"against {key}; a line per {', '.join(o for o in camp.group_by if o != key)}",
+                         fontsize=9)
+            if n > 1:
+                ax.legend(fontsize=7, ncol=2 if n > 6 else 1)
+        axes[0].set_ylabel(f"{m} [{unit}]")
+        fig.suptitle(f"{camp.title}\n{info['meaning']}: mean +- std (ddof=1) per group", fontsize=9)
+        fig.subplots_adjust(left=0.07, right=0.985, top=0.86, bottom=0.12, wspace=0.06)
+        path = os.path.join(pdir, f"{m}_by_keys.png")
+        fig.savefig(path, dpi=90)
+        plt.close(fig)
+        written.append(path)
+    return written
 
 
 def _margins(fig, labels, rot, wspace=0.06):
@@ -1265,4 +1358,5 @@ def _plots(camp, out_dir, result, rows):
         fig.savefig(path, dpi=90)
         plt.close(fig)
         written.append(path)
+    written += _by_key_plots(camp, pdir, result, rows, plt)
     return written

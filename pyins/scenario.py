@@ -1,8 +1,10 @@
 """Scenario files (TOML): what to simulate, how the firmware is set up, what to compare.
 
-A scenario file names a ship motion, sensor errors (a preset and/or values
-with units such as ``"0.003 deg/h"``), the turntable and its indexing
-scheme, the firmware configuration (alignment, ...), errors of the initial
+A scenario file names a ship motion (a fixed-position one may add heave,
+surge and sway of the ship's reference point and lever arms to the IMU:
+`pyins.sim.ShipAtSea`), sensor errors (a preset and/or values with units
+such as ``"0.003 deg/h"``), the turntable and its indexing scheme, the
+firmware configuration (alignment, ...), errors of the initial
 state, the duration, the noise seed and the record interval; optionally a
 ``[compare]`` table that runs variants side by side, the ``[paper]``
 figures it reproduces and which ``[outputs]`` to write. docs/scenarios.md
@@ -33,6 +35,7 @@ import copy
 import difflib
 import hashlib
 import json
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +50,7 @@ import numpy as np
 from pyins import sim
 from pyins.reference import attitude, earth
 from pyins.sim import motion as sim_motion
+from pyins.sim import ship as sim_ship
 from pyins.sim import turntable
 from pyins.units import UNITS, ScenarioError, parse_quantity, split_quantity
 
@@ -157,6 +161,50 @@ SEGMENT_KEYS = {
     "angle": _angle("yaw change, counter-clockwise (turn)", None, "-3600 deg", "3600 deg"),
 }
 
+#: Keys of the fixed-position kinds (static, swing, sea_state, heading_swing)
+#: that make the ship a `pyins.sim.ShipAtSea`: heave, surge and sway of the
+#: motion reference point (sinusoids or a wave spectrum) and the lever arms.
+#: Any of them present: a ShipAtSea; none: the base profile itself.
+SHIP_KEYS = {
+    "heave": Key("tables", "heave (up) of the motion reference point: sinusoids "
+                           "{amplitude, period, phase}"),
+    "surge": Key("tables", "surge (along the mean bow) of the reference point: sinusoids"),
+    "sway": Key("tables", "sway (along the mean starboard) of the reference point: sinusoids"),
+    "spectrum": Key("table", "heave, surge and sway drawn from a wave spectrum: {name} or "
+                             "{hs, tp, kind, gamma, seed, components} (instead of heave/surge/sway)"),
+    "lever_b": Key("length", "motion reference point -> turntable centre in the ship frame b "
+                             "[x starboard, y bow, z up]; length <= 100 m", lo="-100 m", hi="100 m",
+                   shape=3),
+    "lever_p": Key("length", "turntable centre -> accelerometer triad in the IMU frame p (turns "
+                             "with the table); length <= 100 m", lo="-100 m", hi="100 m", shape=3),
+}
+#: Keys of one sinusoid of heave, surge or sway: a sin(2 pi t / T + phase).
+COMPONENT_KEYS = {
+    "amplitude": Key("length", "amplitude a", required=True, lo="-100 m", hi="100 m"),
+    "period": Key("time", "period T (not only whole ticks)", required=True, lo="0 s", hi="1 d",
+                  lo_open=True),
+    "phase": _angle("phase at t = 0", "0 deg", "-360 deg", "360 deg"),
+}
+#: Keys of [motion] spectrum (pyins.sim.sea_spectrum_motion).
+SPECTRUM_KEYS = {
+    "name": Key("choice", "a preset sea of pyins.sim.SEA_STATE_SPECTRA: sets the defaults of hs, "
+                          "tp and gamma", choices=tuple(sim.SEA_STATE_SPECTRA)),
+    "hs": Key("length", "significant wave height (required without name)", lo="0 m", hi="30 m",
+              lo_open=True),
+    "tp": Key("time", "peak period (required without name)", lo="0 s", hi="60 s", lo_open=True),
+    "kind": Key("choice", "JONSWAP or (modified) Pierson-Moskowitz", "jonswap",
+                choices=("jonswap", "pm")),
+    "gamma": Key("dimensionless", "JONSWAP peak enhancement (default 3.3, a preset's own; not "
+                                  "used by pm)", lo=1, hi=7),
+    "seed": Key("int", "seed of the components' random phases (not the noise seed)", default=0,
+                lo=0),
+    "components": Key("int", "sinusoids per axis", default=40, lo=1, hi=1000),
+}
+_FIXED_KINDS = ("static", "swing", "sea_state", "heading_swing")
+_LINEAR_AXES = ("heave", "surge", "sway")
+for _kind in _FIXED_KINDS:
+    MOTION_KINDS[_kind].update(SHIP_KEYS)
+
 SENSOR_KEYS = {
     "preset": Key("choice", "sensor error preset the values below override", "error_free",
                   choices=tuple(sim.PRESETS)),
@@ -227,6 +275,8 @@ STEP_KEYS = {
 
 _VERTICAL_MODES = {"hold": 0, "free": 1}
 _FINE_CORRECTIONS = {"feedback": 0, "open_loop": 1}
+#: coarse_method name -> pyins_coarse_method
+_COARSE_METHODS = {"triad": 0, "fit": 1}
 FIRMWARE_KEYS = {
     "initial_attitude": Key("choice", "attitude the firmware starts from: the true one (plus "
                                       "[initial_errors]) or all Euler angles zero", "truth",
@@ -240,6 +290,12 @@ FIRMWARE_KEYS = {
                                  lo="0.01 s"),
     "coarse_output_every": _time("coarse solution interval (firmware default 1 s)", None,
                                  lo="0.01 s"),
+    "coarse_method": Key("choice", "coarse alignment: 'triad' (seed 000, a base that does not move) "
+                                   "or 'fit' (moving base: heave, surge, sway; firmware default "
+                                   "triad)", choices=tuple(_COARSE_METHODS)),
+    "lever": Key("choice", "lever arms the firmware is told: 'configured' (the simulated "
+                           "motion.lever_b and lever_p) or 'unknown' (zero)", "configured",
+                 choices=("configured", "unknown")),
     "fine_time": _time("fine alignment length (0: none)", None),
     "fine_states": Key("int", "fine-alignment filter states, 5 or 8 (firmware default 5)", lo=5, hi=8,
                        choices=(5, 8)),
@@ -485,7 +541,7 @@ def _read(table, path, keys, what=""):
             raise ScenarioError(f"missing (required: {key.doc})", where)
         else:
             raw = key.default
-        if raw is None or key.kind in ("tables", "quantity"):
+        if raw is None or key.kind in ("tables", "table", "quantity"):
             out[name] = raw
         else:
             out[name] = _convert(raw, key, where)
@@ -516,6 +572,12 @@ def _resolve_motion(table, duration_s):
         raise ScenarioError("missing (required: motion profile, one of "
                             f"{', '.join(MOTION_COMMON['kind'].choices)})", "motion.kind")
     kind = _convert(table["kind"], MOTION_COMMON["kind"], "motion.kind")
+    if kind not in _FIXED_KINDS:
+        for name in SHIP_KEYS:
+            if name in table:
+                raise ScenarioError(f"not used with kind {kind!r}: heave, surge, sway, spectrum and "
+                                    f"lever arms need a fixed-position kind ({', '.join(_FIXED_KINDS)})",
+                                    f"motion.{name}")
     keys = dict(MOTION_COMMON)
     keys.update(MOTION_KINDS[kind])
     if kind == "heading_swing":
@@ -545,7 +607,15 @@ def _resolve_motion(table, duration_s):
             raise ScenarioError("give either yaw or heading, not both", "motion.heading")
         v["yaw"] = -v["heading"]
     del v["heading"]
+    ship = {name: v.pop(name) for name in SHIP_KEYS if name in keys}
+    ship = {name: value for name, value in ship.items() if name in table}
     res = _si(v, keys)
+    res.update(_resolve_ship(table, ship))
+    if any(res.get("lever_p_m", ())):
+        try:        # what pyins.fil.run_fil will ask of the motion
+            sim.node_rates(_build_motion(res), np.arange(1), dt=DT)
+        except ValueError as exc:
+            raise ScenarioError(str(exc), "motion.lever_p") from None
     if kind == "manoeuvre":
         res["segments"] = _resolve_segments(v["segments"])
         length = _build_motion(res).duration
@@ -553,6 +623,79 @@ def _resolve_motion(table, duration_s):
             raise ScenarioError(f"the manoeuvre lasts {length:g} s, shorter than the duration "
                                 f"{duration_s:g} s", "motion.segments")
     return res
+
+
+def _resolve_components(raw, where):
+    """heave/surge/sway: an array of {amplitude, period, phase} (or one table)."""
+    if isinstance(raw, dict):
+        tables, names = [raw], [where]
+    else:
+        tables = _array_of_tables(raw, where, 0, 1000)
+        names = [f"{where}[{i}]" for i in range(len(tables))]
+    return [_si(_read(t, p, COMPONENT_KEYS), COMPONENT_KEYS) for t, p in zip(tables, names)]
+
+
+def _resolve_spectrum(raw):
+    where = "motion.spectrum"
+    _need_table(raw, where)
+    v = _read(raw, where, SPECTRUM_KEYS)
+    if v["name"] is not None:
+        preset = sim.SEA_STATE_SPECTRA[v["name"]]
+        for name in ("hs", "tp", "gamma"):
+            if v[name] is None:
+                v[name] = float(preset[name])
+    else:
+        for name in ("hs", "tp"):
+            if v[name] is None:
+                raise ScenarioError(f"missing (required unless 'name' is given: "
+                                    f"{SPECTRUM_KEYS[name].doc.split(' (')[0]})", f"{where}.{name}")
+    if v["kind"] == "pm":
+        if "gamma" in raw:
+            raise ScenarioError("not used with kind = 'pm' (the Pierson-Moskowitz spectrum has no "
+                                "peak enhancement)", f"{where}.gamma")
+        v["gamma"] = None
+    elif v["gamma"] is None:
+        v["gamma"] = 3.3
+    res = _si(v, SPECTRUM_KEYS)
+    try:
+        _spectrum_motion(res)
+    except ValueError as exc:
+        raise ScenarioError(str(exc), where) from None
+    return res
+
+
+def _spectrum_motion(sp):
+    return sim.sea_spectrum_motion(sp["hs_m"], sp["tp_s"], spectrum=sp["kind"],
+                                   gamma=sp["gamma"] if sp["gamma"] is not None else 1.0,
+                                   seed=sp["seed"], n_components=sp["components"])
+
+
+def _resolve_ship(table, ship):
+    """The resolved ship keys (only those the file gives: a file without them
+    resolves, and digests, exactly as before they existed)."""
+    out = {}
+    for name in _LINEAR_AXES:
+        if name in ship:
+            out[name] = _resolve_components(ship[name], f"motion.{name}")
+    if "spectrum" in ship:
+        given = [name for name in _LINEAR_AXES if name in ship]
+        if given:
+            raise ScenarioError(f"give either a spectrum or heave/surge/sway sinusoids, not both "
+                                f"(the file gives {', '.join(given)} too)", "motion.spectrum")
+        out["spectrum"] = _resolve_spectrum(ship["spectrum"])
+    for name in ("lever_b", "lever_p"):
+        if name in ship:
+            where = f"motion.{name}"
+            if not isinstance(table[name], list):
+                raise ScenarioError(f"must be a list of 3 lengths [x starboard, y bow, z up], got "
+                                    f"{_type_name(table[name])} {table[name]!r}", where)
+            r = [float(x) for x in ship[name]]
+            length = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+            if length > sim_ship.MAX_METRES:
+                raise ScenarioError(f"out of range: the lever arm is {length:g} m long; it must be "
+                                    f"<= {sim_ship.MAX_METRES:g} m", where)
+            out[name + "_m"] = r
+    return out
 
 
 def _resolve_segments(raw):
@@ -586,8 +729,32 @@ def _resolve_segments(raw):
     return legs
 
 
+_SHIP_RESOLVED = ("heave", "surge", "sway", "spectrum", "lever_b_m", "lever_p_m")
+
+
+def _is_ship(m):
+    """True when a resolved [motion] has any ship key (a pyins.sim.ShipAtSea)."""
+    return any(k in m for k in _SHIP_RESOLVED)
+
+
 def _build_motion(m):
-    """A pyins.sim motion object from a resolved [motion] dict."""
+    """A pyins.sim motion object from a resolved [motion] dict: the base
+    profile, wrapped in a ShipAtSea when any ship key is given."""
+    base = _build_base_motion(m)
+    if not _is_ship(m):
+        return base
+    linear = None
+    if "spectrum" in m:
+        linear = _spectrum_motion(m["spectrum"])
+    elif any(a in m for a in _LINEAR_AXES):
+        linear = sim.LinearMotion(**{a: [(c["amplitude_m"], c["period_s"], c["phase_rad"])
+                                         for c in m.get(a, [])] for a in _LINEAR_AXES})
+    return sim.ShipAtSea(base, linear, lever_b=m.get("lever_b_m", (0.0, 0.0, 0.0)),
+                         lever_p=m.get("lever_p_m", (0.0, 0.0, 0.0)))
+
+
+def _build_base_motion(m):
+    """The profile of a resolved [motion] dict without its ship keys."""
     kind = m["kind"]
     lat, lon, h = m["lat_rad"], m["lon_rad"], m["height_m"]
     if kind == "static":
@@ -620,7 +787,11 @@ def _initial_truth(m):
         return (m["lat_rad"], m["lon_rad"], m["height_m"],
                 np.array([-speed * np.sin(yaw), speed * np.cos(yaw), 0.0]),
                 np.array([m["pitch_rad"], m["roll_rad"], yaw]))
-    st = _build_motion(m).state(np.array([0.0]))
+    motion = _build_motion(m)
+    # a ShipAtSea: the reference point's state, which the firmware's configuration means
+    # (pyins.runner.initial_config); every other profile: its own state
+    state = motion.reference_state if isinstance(motion, sim.ShipAtSea) else motion.state
+    st = state(np.array([0.0]))
     return float(st.lat[0]), float(st.lon[0]), float(st.height[0]), st.vel_n[0], st.euler[0]
 
 
@@ -755,6 +926,12 @@ def _resolve(data, stem):
         raise ScenarioError("missing table [motion] (required: the ship's motion)", "motion")
     motion = _resolve_motion(data["motion"], duration_s)
     firmware = _resolve_firmware(data.get("firmware", {}), duration_s)
+    # keys newer than schema 1's files are resolved only when they say
+    # something, so that the older files keep their digests
+    if firmware["coarse_method"] is None:
+        del firmware["coarse_method"]
+    if firmware["lever"] == "configured" and not _is_ship(motion):
+        del firmware["lever"]
     res = {
         "schema": SCHEMA_VERSION,
         "name": name,
@@ -806,6 +983,13 @@ def _firmware_config(res):
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
         cfg["fine_correction"] = _FINE_CORRECTIONS[fw["fine_correction"]]
+    if fw.get("coarse_method") is not None:
+        cfg["coarse_method"] = _COARSE_METHODS[fw["coarse_method"]]
+    if fw.get("lever") == "unknown":
+        # what an unknown lever arm costs: the firmware navigates the reference point as if
+        # the accelerometers were there (runner.initial_config would give it the motion's)
+        cfg["lever_b_m"] = [0.0, 0.0, 0.0]
+        cfg["lever_p_m"] = [0.0, 0.0, 0.0]
     for name, c_name in (("stop_s", "index_stop_ticks"), ("timeout_s", "index_timeout_ticks")):
         if ix[name] is not None:
             cfg[c_name] = _ticks(ix[name])
@@ -875,7 +1059,8 @@ _STATUS_KEYS = {
     "PYINS_E_CONFIG_NOISE": "firmware", "PYINS_E_CONFIG_INDEX_SCHEME": "indexing.scheme",
     "PYINS_E_CONFIG_INDEX_EMPTY": "indexing.steps", "PYINS_E_CONFIG_INDEX_RATE": "indexing.rate",
     "PYINS_E_CONFIG_INDEX_DELTA": "indexing.delta", "PYINS_E_CONFIG_INDEX_STEP": "indexing",
-    "PYINS_E_CONFIG_INDEX_SUMS": "indexing.sums",
+    "PYINS_E_CONFIG_INDEX_SUMS": "indexing.sums", "PYINS_E_CONFIG_LEVER": "motion.lever_b",
+    "PYINS_E_CONFIG_COARSE_METHOD": "firmware.coarse_method",
 }
 
 
@@ -886,9 +1071,12 @@ def _firmware_check(res, cfg):
         from pyins import native
     except ImportError:
         return
-    lat, lon, h, vel, euler = _initial_truth(res["motion"])
+    m = res["motion"]
+    lat, lon, h, vel, euler = _initial_truth(m)
     full = dict(lat_rad=lat, lon_rad=lon, height_m=h, vel_n_mps=vel, euler_b_rad=euler,
                 table_angle_rad=0.0)
+    if _is_ship(m):     # the lever arms runner.initial_config hands over (cfg may zero them)
+        full.update(lever_b_m=m.get("lever_b_m", [0.0] * 3), lever_p_m=m.get("lever_p_m", [0.0] * 3))
     full.update(cfg)
     status = native.lib.pyins_config_check(native.make_config(full))
     if status != 0:

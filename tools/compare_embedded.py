@@ -43,7 +43,8 @@ def python_lines():
     """The demo of csrc/embedded/demo_main.c through pyins.native."""
     ffi, lib = native.ffi, native.lib
     cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
-               fine_states=5, index_scheme=2, index_stop_ticks=2000, seq_mode=1)
+               fine_states=12, index_scheme=2, index_stop_ticks=2000, seq_mode=1,
+               coarse_method=1, lever_b_m=[0.5, 1.5, 1.25], lever_p_m=[0.0625, 0.0, 0.0])
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
     state = 1
@@ -66,7 +67,8 @@ def python_lines():
         sample.dtheta_p_rad[2] = 4.103617522881293e-07 + unit() * k_ang
         sample.dv_p_mps[0] = unit() * k_vel
         sample.dv_p_mps[1] = unit() * k_vel
-        sample.dv_p_mps[2] = 0.09796698857772466 + unit() * k_vel
+        sample.dv_p_mps[2] = (0.09796698857772466 + unit() * k_vel
+                              + float(2 * (k % 800) - 799) * (1.0 / 4194304.0))   # the heave
         sample.table_angle_rad = enc
         sample.seq = k + 1
         if fault == DEMO_NAN:

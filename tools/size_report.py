@@ -17,7 +17,9 @@ entry point; pyins_step's is the one an ISR-driven firmware needs (plus its
 own frame and an exception frame).
 
 Cost per tick, in each mode of csrc/embedded/bench_modes.h (nav, navix =
-navigation with the two-position scheme, coarse, fine5, fine8; 3000 ticks):
+navigation with the two-position scheme, coarse, fine5, fine8, fit = the
+moving-base coarse alignment with a lever arm, fine12 = the moving-base fine
+filter; 3000 ticks):
   - host: instructions inside pyins_step from callgrind (build/host/bench_step);
   - Cortex-M7 and M4F: instructions per pyins_step, mean and worst tick,
     measured under QEMU with -icount (csrc/embedded/bench_main.c: SysTick
@@ -46,7 +48,7 @@ import stack_depth  # noqa: E402
 from pyins import native  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MODES = ("nav", "navix", "coarse", "fine5", "fine8")
+MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12")
 TARGETS = (("cortex-m7", "build-m7", "mps2-an500"), ("cortex-m4f", "build-m4", "mps2-an386"))
 TICK_HZ = 100
 

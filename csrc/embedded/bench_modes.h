@@ -10,6 +10,8 @@
  *   coarse  COARSE_ALIGN (first solution at 20 s, then one every 1 s)
  *   fine5   FINE_ALIGN, 5-state filter (measurement update every 10 ticks)
  *   fine8   FINE_ALIGN, 8-state filter
+ *   fit     COARSE_ALIGN by FIT (moving base), a 2 m lever arm
+ *   fine12  FINE_ALIGN, the moving-base 12-state filter (1 Hz updates), lever arm
  * The IMU swings gently, so every branch of a moving step runs. */
 #ifndef PYINS_BENCH_MODES_H
 #define PYINS_BENCH_MODES_H
@@ -18,9 +20,11 @@
 
 #include "pyins_core.h"
 
-enum { BENCH_NAV, BENCH_NAVIX, BENCH_COARSE, BENCH_FINE5, BENCH_FINE8, BENCH_N_MODES };
+enum { BENCH_NAV, BENCH_NAVIX, BENCH_COARSE, BENCH_FINE5, BENCH_FINE8, BENCH_FIT, BENCH_FINE12,
+       BENCH_N_MODES };
 
-static const char *const bench_mode_name[BENCH_N_MODES] = {"nav", "navix", "coarse", "fine5", "fine8"};
+static const char *const bench_mode_name[BENCH_N_MODES] = {"nav", "navix", "coarse", "fine5", "fine8",
+                                                           "fit", "fine12"};
 
 /* The mode called name, or -1. */
 static int bench_mode_of(const char *name) {
@@ -53,6 +57,20 @@ static int bench_config(int m, long n, pyins_config *cfg) {
         case BENCH_FINE8:
             cfg->fine_ticks = (int32_t)n + 1;
             cfg->fine_states = m == BENCH_FINE8 ? 8 : 5;
+            return 0;
+        case BENCH_FIT:
+            cfg->coarse_ticks = (int32_t)n + 1;   /* FIT has no length limit */
+            cfg->coarse_method = PYINS_COARSE_FIT;
+            cfg->lever_b_m[0] = 0.5;
+            cfg->lever_b_m[1] = 1.5;
+            cfg->lever_b_m[2] = 1.2;
+            return 0;
+        case BENCH_FINE12:
+            cfg->fine_ticks = (int32_t)n + 1;
+            cfg->fine_states = 12;
+            cfg->lever_b_m[0] = 0.5;
+            cfg->lever_b_m[1] = 1.5;
+            cfg->lever_b_m[2] = 1.2;
             return 0;
         default:
             return -1;

@@ -19,10 +19,17 @@ void demo_config(pyins_config *cfg) {
     cfg->lon_rad = 1.9008380883470242;       /* 108.910 deg */
     cfg->coarse_ticks = 6000;
     cfg->fine_ticks = 6000;
-    cfg->fine_states = 5;
+    cfg->fine_states = 12;                  /* the moving-base filter (1 Hz position updates) */
     cfg->index_scheme = PYINS_INDEX_TWO_POSITION;
     cfg->index_stop_ticks = 2000;
     cfg->seq_mode = PYINS_SEQ_CHECK;        /* default gap bridging: up to 2 ticks */
+    /* a moored ship: the moving-base coarse alignment, a 2 m lever arm and
+     * a sensor offset on the table (demo_sample adds a heave) */
+    cfg->coarse_method = PYINS_COARSE_FIT;
+    cfg->lever_b_m[0] = 0.5;
+    cfg->lever_b_m[1] = 1.5;
+    cfg->lever_b_m[2] = 1.25;
+    cfg->lever_p_m[0] = 0.0625;
 }
 
 int demo_fault(uint32_t k) {
@@ -52,7 +59,10 @@ void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, pyins_sample *
     s->dtheta_p_rad[2] = kDthetaU + lcg_unit(state) * k_ang;
     s->dv_p_mps[0] = lcg_unit(state) * k_vel;
     s->dv_p_mps[1] = lcg_unit(state) * k_vel;
-    s->dv_p_mps[2] = kDvU + lcg_unit(state) * k_vel;
+    /* heave: a zero-mean sawtooth acceleration of period 8 s (800 ticks),
+     * odd integers -799..799 times 2^-22 m/s per tick (up to 2 mg) */
+    s->dv_p_mps[2] = kDvU + lcg_unit(state) * k_vel +
+                     (double)(2 * (int32_t)(k % 800u) - 799) * (1.0 / 4194304.0);
     s->table_angle_rad = encoder_rad;
     s->seq = k + 1u;
     s->reserved = 0u;

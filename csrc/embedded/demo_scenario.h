@@ -1,8 +1,10 @@
 /* demo_scenario.h: a fixed firmware scenario built from integer arithmetic
  * only, so the host, the Cortex-M targets and Python (tools/compare_embedded.py)
- * feed the core exactly the same doubles: a static ship at 34.246 N with
+ * feed the core exactly the same doubles: a ship moored at 34.246 N with
  * small deterministic "noise" from a 64-bit LCG (scaled by powers of two,
- * hence exact), 60 s coarse alignment, 60 s fine alignment (5 states), then
+ * hence exact) and a sawtooth heave of 2 mg, the IMU 2 m from the reference
+ * point (lever arm, sensor offset), 60 s of moving-base coarse alignment
+ * (FIT), 60 s of moving-base fine alignment (12 states), then
  * navigation with the traditional two-position scheme (20 s stops) on an
  * ideal table that reads back the previous command. The IMU counts its
  * samples (seq checking on), and a fixed schedule of sample-level faults

@@ -64,9 +64,9 @@ enum pyins_status {
     PYINS_E_CONFIG_MODE = -16,      /* unknown vertical-channel mode */
     PYINS_E_CONFIG_ALIGN_RATIO = -17, /* coarse_ratio not in (0, 1) */
     PYINS_E_CONFIG_ALIGN_EARLY = -18, /* first coarse output before enough data: ratio * first < every */
-    PYINS_E_CONFIG_ALIGN_LONG = -19,  /* coarse alignment longer than its fixed storage allows */
+    PYINS_E_CONFIG_ALIGN_LONG = -19,  /* TRIAD coarse alignment longer than its fixed storage allows (FIT: no limit) */
     PYINS_E_CONFIG_ALIGN_TICKS = -20, /* an alignment duration negative, or first output after its end */
-    PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5 or 8, negative update interval, unknown correction */
+    PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5, 8 or 12, negative update interval, unknown correction */
     PYINS_E_CONFIG_NOISE = -22,       /* a noise density or initial sigma negative or not finite */
     PYINS_E_CONFIG_INDEX_SCHEME = -23, /* unknown indexing scheme */
     PYINS_E_CONFIG_INDEX_EMPTY = -24, /* custom scheme with no steps (or more than 8) */
@@ -82,6 +82,7 @@ enum pyins_status {
     PYINS_E_CONFIG_INDEX_SUMS = -34,  /* unknown index_sums */
     PYINS_E_CONFIG_LEVER = -35,       /* a lever-arm component not finite, or a lever arm longer than 100 m */
     PYINS_E_CONFIG_COARSE_METHOD = -36, /* unknown coarse_method */
+    PYINS_E_CONFIG_INTEGRITY = -37,   /* integrity_nis_window below -1, or a bound negative or not finite */
     PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
     PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
     PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
@@ -152,7 +153,13 @@ enum pyins_fault_flag {
     PYINS_FAULT_SEQ_GAP = 16,     /* ticks were missing from the sequence (n_seq_gaps, n_seq_bridged) */
     PYINS_FAULT_SEQ_REPEAT = 32,  /* a duplicate sample was dropped (n_seq_repeats) */
     PYINS_FAULT_SEQ_LOST = 64,    /* the sequence broke beyond the bridgeable gap (n_seq_lost) */
-    PYINS_FAULT_ENCODER_JUMP = 128 /* the encoder jumped (n_encoder_jumps) */
+    PYINS_FAULT_ENCODER_JUMP = 128, /* the encoder jumped (n_encoder_jumps) */
+    PYINS_FAULT_ALIGN_INCONSISTENT = 256, /* the fine alignment's measurements do not fit its model:
+                                             a window's mean normalised innovation squared (align_nis)
+                                             beyond integrity_nis_max; the attitude is not valid */
+    PYINS_FAULT_COARSE_UNSETTLED = 512 /* the coarse solution kept moving over the last fifth of the
+                                          coarse alignment by more than integrity_coarse_rad
+                                          (coarse_wander_rad); the attitude is not valid */
 };
 
 /* Sequence checking (pyins_config.seq_mode). */
@@ -171,7 +178,12 @@ enum pyins_mode {
 
 /* Bits of pyins_output.state_flags. */
 enum pyins_state_flag {
-    PYINS_STATE_ATT_VALID = 1     /* the attitude is a solution, not the configured guess */
+    PYINS_STATE_ATT_VALID = 1     /* the attitude is a solution, not the configured guess nor a
+                                     provisional one (coarse solutions until the coarse alignment
+                                     has ended and passed its wander test; a fine estimate before
+                                     the first NIS window has passed), and no
+                                     integrity test failed (PYINS_FAULT_ALIGN_INCONSISTENT,
+                                     PYINS_FAULT_COARSE_UNSETTLED: once set, never valid again) */
 };
 
 /* Vertical channel: a marine INS holds height at the reference (external
@@ -200,12 +212,15 @@ typedef struct pyins_config {
     int32_t reserved0;            /* padding, ignored; keep 0 */
     double coarse_ratio;          /* r = t_k1 / t_k2 in (0, 1); 0 = 1/2 */
     int32_t fine_ticks;           /* FINE_ALIGN duration [ticks]; 0 = none */
-    int32_t fine_states;          /* 5 (reduced filter) or 8 (full); 0 = 5 */
-    int32_t fine_meas_every_ticks; /* ticks per measurement update; 0 = 10 */
+    int32_t fine_states;          /* 5 (reduced filter) or 8 (full): seed 001's static filters;
+                                     12: the moving-base filter (position matching on a moored
+                                     ship, docs/concepts.md); 0 = 5 */
+    int32_t fine_meas_every_ticks; /* ticks per measurement update; 0 = 10 (static), 100 (moving base) */
     int32_t fine_correction;      /* enum pyins_fine_correction */
     double fine_gyro_arw;         /* Q: gyro angle random walk [rad/sqrt(s)]; 0 = 0.001 deg/sqrt(h) */
     double fine_accel_vrw;        /* R: accelerometer velocity random walk [(m/s)/sqrt(s)]; 0 = 10 ug/sqrt(Hz) */
-    double fine_sigma0_att_rad[3]; /* initial sigma of phi E, N, U [rad]; 0 = 100', 100', 600' */
+    double fine_sigma0_att_rad[3]; /* initial sigma of phi E, N, U [rad]; 0 = 100', 100', 600'
+                                      (moving base, fine_states 12: 1', 1', 10') */
     double fine_sigma0_gyro;      /* initial sigma of the gyro drifts [rad/s]; 0 = 0.01 deg/h */
     double fine_sigma0_accel;     /* initial sigma of the accelerometer biases [m/s^2]; 0 = 100 ug */
     /* Indexing (rotation modulation), active in NAVIGATE. For preset schemes
@@ -235,6 +250,15 @@ typedef struct pyins_config {
     double lever_p_m[3];          /* turntable centre -> accelerometer triad, in p [m]; |r| <= 100 m */
     int32_t coarse_method;        /* enum pyins_coarse_method; 0 = seed 000's TRIAD */
     int32_t reserved2;            /* padding, ignored; keep 0 */
+    /* Integrity tests of the alignment (docs/concepts.md, "Integrity"). */
+    int32_t integrity_nis_window; /* fine-alignment updates per NIS window; 0 = 100, -1 = no test */
+    int32_t reserved3;            /* padding, ignored; keep 0 */
+    double integrity_nis_max;     /* bound on a window's mean NIS (2 when the model holds); 0 = 4 */
+    double integrity_coarse_rad;  /* bound on the coarse solution's wander over its last fifth [rad];
+                                     0 = 30 arcmin */
+    /* The moving-base fine alignment (fine_states = 12). */
+    double fine_pos_sigma_m;      /* R: the waves' horizontal displacement [m]; 0 = 0.5 m */
+    double fine_sigma0_vel_mps;   /* initial sigma of the velocity error [m/s]; 0 = 0.5 m/s */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -263,9 +287,10 @@ typedef struct pyins_output {
     double heading_b_rad;         /* ship heading, clockwise from North, [0, 2 pi) [rad] */
     double yaw_p_rad;             /* IMU yaw psi_p = psi_b + alpha, CCW, (-pi, pi] [rad] */
     double table_angle_rad;       /* unwrapped turntable angle alpha [rad] */
-    int32_t kf_states;            /* 0 before fine alignment, else 5 or 8 (its last values stay) */
+    int32_t kf_states;            /* 0 before fine alignment, else 5, 8 or 12 (its last values stay) */
     int32_t align_restarts;       /* alignments restarted after a rejected sample */
-    double kf_x[8];               /* fine-alignment state, fine_align.hpp layout [rad, rad/s, m/s^2] */
+    double kf_x[8];               /* fine-alignment state, fine_align.hpp layout [rad, rad/s, m/s^2];
+                                     12 states: [phi, eps, nabla_E, nabla_N] as the 8-state filter */
     double kf_sigma[8];           /* its standard deviations, same units */
     int32_t index_state;          /* enum pyins_index_state */
     int32_t index_step;           /* step of the cycle */
@@ -285,6 +310,11 @@ typedef struct pyins_output {
     uint32_t n_seq_lost;          /* sequence breaks beyond the bridgeable gap */
     uint32_t n_encoder_jumps;     /* encoder jumps */
     uint32_t seq;                 /* seq of the last sample taken (0 before any) */
+    double align_nis;             /* mean NIS of the last complete window of fine-alignment updates
+                                     (0 before the first); 2 when the filter's model holds */
+    double coarse_wander_rad;     /* sine of the largest rotation of the coarse solution from its
+                                     value at the start of the coarse alignment's last fifth
+                                     (1 for 90 deg or more) */
 } pyins_output;
 
 /* The firmware instance. Opaque: it lives in caller memory of

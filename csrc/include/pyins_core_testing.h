@@ -62,6 +62,28 @@ typedef struct pyins_t_index_out {
     double cmd_angle, cmd_rate, a_c, a_s;
 } pyins_t_index_out;
 
+typedef struct pyins_t_moving_params {
+    double sin_lat, cos_lat, rm_h, rn_h, dt;
+    int32_t meas_every;
+    int32_t nis_window;
+    double gyro_arw, accel_vrw, pos_sigma;
+    double sigma0_att[3];
+    double sigma0_vel, sigma0_gyro, sigma0_accel, nis_max;
+} pyins_t_moving_params;
+
+/* coarse_align (moving base) */
+void pyins_t_coarse_pos_i(double t, double sin_lat, double cos_lat, double gravity, double out[3]);
+void pyins_t_coarse_fit_weights(double s, double *phi_a, double *phi_b);
+void pyins_t_coarse_solve_fit(const double *grid, int32_t n, double t_step, double sin_lat,
+                              double cos_lat, double gravity, double m[9]);
+double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]);
+
+/* moving_align: n ticks of dv_sf_n (n x 3) and z (n x 2, read at the update
+ * ticks); writes x (12) and P (144, row-major); returns the number of
+ * updates, and the last window mean NIS in *nis_mean. */
+int pyins_t_moving_align_run(const pyins_t_moving_params *p, const double *dv_sf_n, const double *z,
+                             size_t n, double *x_out, double *p_out, double *nis_mean);
+
 /* math_portable */
 double pyins_t_sin(double x);
 double pyins_t_cos(double x);

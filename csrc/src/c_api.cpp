@@ -319,8 +319,8 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_MODE: return "PYINS_E_CONFIG_MODE: vertical_mode must be PYINS_VERTICAL_HOLD or PYINS_VERTICAL_FREE";
         case PYINS_E_CONFIG_ALIGN_RATIO: return "PYINS_E_CONFIG_ALIGN_RATIO: coarse_ratio must be in (0, 1) (0 = default 1/2)";
         case PYINS_E_CONFIG_ALIGN_EARLY: return "PYINS_E_CONFIG_ALIGN_EARLY: first coarse output before enough data (coarse_ratio * first output < output interval)";
-        case PYINS_E_CONFIG_ALIGN_LONG: return "PYINS_E_CONFIG_ALIGN_LONG: coarse alignment longer than its storage allows (255 output intervals)";
-        case PYINS_E_CONFIG_FINE: return "PYINS_E_CONFIG_FINE: fine_states must be 5 or 8, the update interval positive, the correction known";
+        case PYINS_E_CONFIG_ALIGN_LONG: return "PYINS_E_CONFIG_ALIGN_LONG: TRIAD coarse alignment longer than its storage allows (255 output intervals; FIT has no limit)";
+        case PYINS_E_CONFIG_FINE: return "PYINS_E_CONFIG_FINE: fine_states must be 5, 8 or 12, the update interval positive, the correction known";
         case PYINS_E_CONFIG_NOISE: return "PYINS_E_CONFIG_NOISE: noise densities and initial sigmas must be positive and finite (0 = default)";
         case PYINS_E_CONFIG_INDEX_SCHEME: return "PYINS_E_CONFIG_INDEX_SCHEME: index_scheme is not one of the pyins_index_scheme values";
         case PYINS_E_CONFIG_INDEX_EMPTY: return "PYINS_E_CONFIG_INDEX_EMPTY: a custom indexing scheme needs 1..8 steps";
@@ -337,6 +337,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
         case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m and lever_p_m must be finite and at most 100 m long";
         case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD or PYINS_COARSE_FIT";
+        case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
         case PYINS_W_SEQ_GAP: return "PYINS_W_SEQ_GAP: ticks missing before this sample: bridged (navigation) or alignment restarted; sample taken";
         case PYINS_W_SEQ_REPEAT: return "PYINS_W_SEQ_REPEAT: a sample already taken (seq repeated or behind): dropped, state unchanged";
         case PYINS_W_SEQ_LOST: return "PYINS_W_SEQ_LOST: seq jumped beyond the bridgeable gap: sample taken without bridging, sequence resynchronised";
@@ -533,6 +534,8 @@ int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params* p, const d
     prm.sigma0_att[2] = p->sigma0_att[2];
     prm.sigma0_gyro = p->sigma0_gyro;
     prm.sigma0_accel = p->sigma0_accel;
+    prm.nis_window = 0;   // the hook runs the filter alone, without the integrity test
+    prm.nis_max = 0.0;
     if (states == 5) {
         fine_run<5>(prm, dv_sf_n, n, x_out, p_out);
     } else if (states == 8) {
@@ -541,6 +544,66 @@ int pyins_t_fine_align_run(int32_t states, const pyins_t_fine_params* p, const d
         return -1;
     }
     return 0;
+}
+
+void pyins_t_coarse_pos_i(double t, double sin_lat, double cos_lat, double gravity, double out[3]) {
+    put3(pyins::coarse_align::pos_i(t, sin_lat, cos_lat, gravity), out);
+}
+
+void pyins_t_coarse_fit_weights(double s, double* phi_a, double* phi_b) {
+    pyins::coarse_align::fit_weights(s, phi_a, phi_b);
+}
+
+void pyins_t_coarse_solve_fit(const double* grid, int32_t n, double t_step, double sin_lat,
+                              double cos_lat, double gravity, double m[9]) {
+    pyins::Vec3 g[pyins::coarse_align::kHistLen];
+    const int32_t k_max = n < pyins::coarse_align::kHistLen ? n : pyins::coarse_align::kHistLen;
+    for (int32_t k = 0; k < k_max; ++k) {
+        g[k] = v3(grid + 3 * k);
+    }
+    put9(pyins::coarse_align::solve_fit(g, k_max, t_step, sin_lat, cos_lat, gravity), m);
+}
+
+double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]) {
+    return pyins::coarse_align::rotation_sine(m9(a), m9(b));
+}
+
+int pyins_t_moving_align_run(const pyins_t_moving_params* p, const double* dv_sf_n, const double* z,
+                             size_t n, double* x_out, double* p_out, double* nis_mean) {
+    pyins::moving_align::Params prm;
+    prm.sin_lat = p->sin_lat;
+    prm.cos_lat = p->cos_lat;
+    prm.rm_h = p->rm_h;
+    prm.rn_h = p->rn_h;
+    prm.dt = p->dt;
+    prm.meas_every = p->meas_every;
+    prm.gyro_arw = p->gyro_arw;
+    prm.accel_vrw = p->accel_vrw;
+    prm.pos_sigma = p->pos_sigma;
+    prm.sigma0_att[0] = p->sigma0_att[0];
+    prm.sigma0_att[1] = p->sigma0_att[1];
+    prm.sigma0_att[2] = p->sigma0_att[2];
+    prm.sigma0_vel = p->sigma0_vel;
+    prm.sigma0_gyro = p->sigma0_gyro;
+    prm.sigma0_accel = p->sigma0_accel;
+    prm.nis_window = p->nis_window;
+    prm.nis_max = p->nis_max;
+    pyins::moving_align::MovingAlign m;
+    pyins::moving_align::init(m, prm);
+    int updates = 0;
+    for (size_t k = 0; k < n; ++k) {
+        if (pyins::moving_align::step(m, v3(dv_sf_n + 3 * k), z + 2 * k)) {
+            updates = updates + 1;
+        }
+    }
+    for (int i = 0; i < pyins::moving_align::kStates; ++i) {
+        x_out[i] = m.x(i);
+        for (int j = 0; j < pyins::moving_align::kStates; ++j) {
+            p_out[pyins::moving_align::kStates * i + j] = m.p(i, j);
+        }
+    }
+    *nis_mean = m.nis_mean;
+    return updates;
 }
 
 void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const double* meas,

@@ -141,6 +141,19 @@ Mat3 mat_e_i(double t) {
     return m;
 }
 
+double rotation_sine(const Mat3& a, const Mat3& b) {
+    // R = a^T b = I cos t + (1 - cos t) u u^T + sin t [u x]: the skew part
+    // is sin t u, the trace 1 + 2 cos t.
+    const Mat3 r = a.transpose() * b;
+    if (r(0, 0) + r(1, 1) + r(2, 2) < 1.0) {
+        return 1.0;
+    }
+    const double x = 0.5 * (r(2, 1) - r(1, 2));
+    const double y = 0.5 * (r(0, 2) - r(2, 0));
+    const double z = 0.5 * (r(1, 0) - r(0, 1));
+    return pmath::sqrt(x * x + y * y + z * z);
+}
+
 void init(CoarseAlign& a, const Params& prm) {
     a.prm = prm;
     a.quat_ib0_p = Quat{1.0, 0.0, 0.0, 0.0};
@@ -158,9 +171,33 @@ void init(CoarseAlign& a, const Params& prm) {
         a.grid[i] = Vec3::Zero();
     }
     a.hist_count = 1;  // v^ib0(t0) = 0, P^ib0(t0) = 0
+    a.grid_every = prm.output_every;
     a.mat_i_ib0 = Mat3::Identity();
     a.solved = false;
+    a.settling = false;
+    a.settle_ref = Mat3::Identity();
+    a.wander = 0.0;
 }
+
+namespace {
+
+/// The wander test on a new solution (see the header).
+void settle(CoarseAlign& a) {
+    if (a.tick < a.prm.settle_from) {
+        return;
+    }
+    if (!a.settling) {
+        a.settling = true;
+        a.settle_ref = a.mat_i_ib0;
+        return;
+    }
+    const double s = rotation_sine(a.settle_ref, a.mat_i_ib0);
+    if (s > a.wander) {
+        a.wander = s;
+    }
+}
+
+}  // namespace
 
 void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p) {
     // Velocity and attitude in ib0: dv rotated by C_p^ib0 at the tick start.
@@ -190,15 +227,27 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
     }
 
     const int64_t every = a.prm.output_every;
-    if (a.tick % every == 0 && a.hist_count < kHistLen) {
+    if (fit && a.tick % a.grid_every == 0 && a.hist_count == kHistLen) {
+        // The grid is full: keep every other point at twice the spacing, so
+        // FIT runs as long as asked in fixed storage (P is smooth: its wave
+        // content has periods of seconds, the spacing after one halving 2
+        // output intervals).
+        for (int32_t k = 1; k < kHistLen / 2; ++k) {
+            a.grid[k] = a.grid[2 * k];
+        }
+        a.hist_count = kHistLen / 2;
+        a.grid_every = 2 * a.grid_every;
+    }
+    if (a.tick % a.grid_every == 0 && a.hist_count < kHistLen) {
         a.grid[a.hist_count] = fit ? a.pos_ib0 : vel;
         a.hist_count = a.hist_count + 1;
     }
     if (a.tick >= a.prm.first_output && (a.tick - a.prm.first_output) % every == 0) {
         if (fit) {
-            a.mat_i_ib0 = solve_fit(a.grid, a.hist_count, static_cast<double>(every) * a.prm.dt,
+            a.mat_i_ib0 = solve_fit(a.grid, a.hist_count, static_cast<double>(a.grid_every) * a.prm.dt,
                                     a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity);
             a.solved = true;
+            settle(a);
             return;
         }
         // t_k1: the history grid point nearest r t_k2, at least one step in,
@@ -224,6 +273,7 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
         }
         a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2);
         a.solved = true;
+        settle(a);
     }
 }
 

@@ -55,6 +55,16 @@
 // enter the t^2 and t^3 terms as in the classical analytic alignment).
 // P^i is closed form: g [cosL (1 - cos wt) / w^2, cosL (wt - sin wt) / w^2,
 // sinL t^2 / 2], by its series (no cancellation, no trigonometry).
+//
+// Integrity: C_ib0^i is a constant; a solution that converges stops moving.
+// From the first output at or after settle_from (the last fifth of the
+// alignment, chosen by the firmware) each solution is compared with that
+// first one, and the largest rotation between them is kept as its sine
+// (`wander`; 1 for 90 deg or more). Every coarse solution is provisional:
+// the firmware reports none with PYINS_STATE_ATT_VALID before the alignment
+// has ended and passed this test. On a moored ship TRIAD moves by tens of
+// arc-minutes over that fifth (164-326' with seed 000's errors), FIT by
+// < 1.5' over 300 s and up to 11' over 120 s (its noise then).
 #pragma once
 
 #include <cstdint>
@@ -64,8 +74,9 @@
 
 namespace pyins::coarse_align {
 
-/// Entries of the v^ib0 history: the longest coarse alignment is
-/// (kHistLen - 1) * output_every ticks (255 s at 1 s outputs).
+/// Entries of the v^ib0 history: the longest TRIAD alignment is
+/// (kHistLen - 1) * output_every ticks (255 s at 1 s outputs); FIT halves
+/// the grid when it fills and has no limit.
 inline constexpr int kHistLen = 256;
 
 /// How C_ib0^i is solved (enum pyins_coarse_method).
@@ -86,6 +97,7 @@ struct Params {
     double sin_lat;
     double cos_lat;
     double gravity;          ///< normal gravity at the site [m/s^2]
+    int64_t settle_from;     ///< first tick of the wander test
 };
 
 struct CoarseAlign {
@@ -97,11 +109,18 @@ struct CoarseAlign {
     Vec3 vel_prev;           ///< reference-point v^ib0 (less u^p(t0)) at the last tick (FIT)
     Vec3 pos_ib0;            ///< its integral [m] (FIT)
     Vec3 lever_vel0;         ///< u^p(t0) [m/s] (TRIAD)
-    Vec3 grid[kHistLen];     ///< at ticks 0, every, 2 every, ...: v^ib0 (TRIAD) or P^ib0 (FIT)
+    Vec3 grid[kHistLen];     ///< at ticks 0, grid_every, 2 grid_every, ...: v^ib0 (TRIAD) or P^ib0 (FIT)
     int32_t hist_count;
+    int64_t grid_every;      ///< grid spacing [ticks]: output_every, doubled by FIT each time the grid fills
     Mat3 mat_i_ib0;          ///< C_ib0^i of the latest solution
     bool solved;             ///< a solution exists
+    bool settling;           ///< settle_ref holds the first solution of the wander test
+    Mat3 settle_ref;         ///< that solution
+    double wander;           ///< sine of the largest rotation from it since (0 before)
 };
+
+/// Sine of the rotation angle between two rotation matrices (1 beyond 90 deg).
+double rotation_sine(const Mat3& a, const Mat3& b);
 
 /// v^i(t) of seed 000 eq. 5 (specific-force form, see above).
 Vec3 vel_i(double t, double sin_lat, double cos_lat, double gravity);

@@ -74,6 +74,13 @@ void init(FineAlign<N>& f, const Params& prm) {
     f.meas_every = prm.meas_every;
     f.meas_span = static_cast<double>(prm.meas_every) * prm.dt;
     f.healthy = true;
+    f.consistent = true;
+    f.nis_window = prm.nis_window;
+    f.nis_max = prm.nis_max;
+    f.nis_sum = 0.0;
+    f.nis_count = 0;
+    f.nis_mean = 0.0;
+    f.nis_windows = 0;
 }
 
 template <int N>
@@ -87,9 +94,21 @@ bool step(FineAlign<N>& f, const Vec3& dv_sf_n) {
         kalman::Vec<2> z;
         z(0) = f.dv_sum(0) / f.meas_span;
         z(1) = f.dv_sum(1) / f.meas_span;
-        kalman::update2<N>(f.x, f.p, f.h, z, f.r);
+        const double nis = kalman::update2<N>(f.x, f.p, f.h, z, f.r);
         f.dv_sum = Vec3::Zero();
         f.meas_count = 0;
+        if (f.nis_window > 0) {
+            f.nis_sum = f.nis_sum + nis;
+            f.nis_count = f.nis_count + 1;
+            if (f.nis_count == f.nis_window) {
+                f.nis_mean = f.nis_sum / static_cast<double>(f.nis_window);
+                f.nis_windows = f.nis_windows + 1;
+                // !(<=) also catches a NaN
+                f.consistent = f.consistent && f.nis_mean <= f.nis_max;
+                f.nis_sum = 0.0;
+                f.nis_count = 0;
+            }
+        }
     }
     f.healthy = f.healthy && kalman::diagonal_positive<N>(f.p);
     return updated;

@@ -130,7 +130,14 @@ pyins_config config_resolved(const pyins_config& in) {
         cfg.fine_states = kDefaultFineStates;
     }
     if (cfg.fine_meas_every_ticks == 0) {
-        cfg.fine_meas_every_ticks = kDefaultFineMeasEvery;
+        cfg.fine_meas_every_ticks = cfg.fine_states == 12 ? kDefaultMovingMeasEverySecond * cfg.tick_hz
+                                                          : kDefaultFineMeasEvery;
+    }
+    if (cfg.fine_pos_sigma_m == 0.0) {
+        cfg.fine_pos_sigma_m = kDefaultPosSigma;
+    }
+    if (cfg.fine_sigma0_vel_mps == 0.0) {
+        cfg.fine_sigma0_vel_mps = kDefaultSigma0Vel;
     }
     if (cfg.fine_gyro_arw == 0.0) {
         cfg.fine_gyro_arw = kDefaultFineArw;
@@ -140,7 +147,8 @@ pyins_config config_resolved(const pyins_config& in) {
     }
     for (int i = 0; i < 3; ++i) {
         if (cfg.fine_sigma0_att_rad[i] == 0.0) {
-            cfg.fine_sigma0_att_rad[i] = kDefaultFineSigmaAtt[i];
+            cfg.fine_sigma0_att_rad[i] = cfg.fine_states == 12 ? kDefaultMovingSigmaAtt[i]
+                                                               : kDefaultFineSigmaAtt[i];
         }
     }
     if (cfg.fine_sigma0_gyro == 0.0) {
@@ -186,6 +194,15 @@ pyins_config config_resolved(const pyins_config& in) {
     if (cfg.sat_accel_mps == 0.0) {
         cfg.sat_accel_mps = kDefaultSatAccel / static_cast<double>(cfg.tick_hz);
     }
+    if (cfg.integrity_nis_window == 0) {
+        cfg.integrity_nis_window = kDefaultNisWindow;
+    }
+    if (cfg.integrity_nis_max == 0.0) {
+        cfg.integrity_nis_max = kDefaultNisMax;
+    }
+    if (cfg.integrity_coarse_rad == 0.0) {
+        cfg.integrity_coarse_rad = kDefaultCoarseWander;
+    }
     return cfg;
 }
 
@@ -229,20 +246,22 @@ int config_check(const pyins_config& raw) {
             static_cast<double>(every)) {
             return PYINS_E_CONFIG_ALIGN_EARLY;
         }
-        if (cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
+        if (cfg.coarse_method == PYINS_COARSE_TRIAD && cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
             return PYINS_E_CONFIG_ALIGN_LONG;
         }
     }
     if (cfg.fine_ticks < 0) {
         return PYINS_E_CONFIG_ALIGN_TICKS;
     }
-    if ((cfg.fine_states != 5 && cfg.fine_states != 8) || cfg.fine_meas_every_ticks < 0 ||
+    if ((cfg.fine_states != 5 && cfg.fine_states != 8 && cfg.fine_states != 12) ||
+        cfg.fine_meas_every_ticks < 0 ||
         (cfg.fine_correction != PYINS_FINE_FEEDBACK && cfg.fine_correction != PYINS_FINE_OPEN_LOOP)) {
         return PYINS_E_CONFIG_FINE;
     }
-    const double noise[7] = {cfg.fine_gyro_arw, cfg.fine_accel_vrw, cfg.fine_sigma0_att_rad[0],
+    const double noise[9] = {cfg.fine_gyro_arw, cfg.fine_accel_vrw, cfg.fine_sigma0_att_rad[0],
                              cfg.fine_sigma0_att_rad[1], cfg.fine_sigma0_att_rad[2],
-                             cfg.fine_sigma0_gyro, cfg.fine_sigma0_accel};
+                             cfg.fine_sigma0_gyro, cfg.fine_sigma0_accel, cfg.fine_pos_sigma_m,
+                             cfg.fine_sigma0_vel_mps};
     for (double v : noise) {
         if (!(v > 0.0) || !std::isfinite(v)) {
             return PYINS_E_CONFIG_NOISE;
@@ -275,6 +294,11 @@ int config_check(const pyins_config& raw) {
     if (cfg.coarse_method == PYINS_COARSE_FIT && cfg.coarse_ticks > 0 &&
         cfg.coarse_first_output_ticks / cfg.coarse_output_every_ticks < coarse_align::kFitMinIntervals) {
         return PYINS_E_CONFIG_ALIGN_EARLY;
+    }
+    if (cfg.integrity_nis_window < -1 || !(cfg.integrity_nis_max > 0.0) ||
+        !std::isfinite(cfg.integrity_nis_max) || !(cfg.integrity_coarse_rad > 0.0) ||
+        !std::isfinite(cfg.integrity_coarse_rad)) {
+        return PYINS_E_CONFIG_INTEGRITY;
     }
     return PYINS_OK;
 }
@@ -312,7 +336,9 @@ void Firmware::init(const pyins_config& raw) {
     prev_dalpha_ = 0.0;
     lever_vel_n_ = Vec3::Zero();
     lever_refine_ = 0;
-    reserved_lever_ = 0;
+    integrity_lost_ = 0;
+    // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
+    coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 
     // The IMU frame at t0: C_p^n = C_b^n C_p^b = C_b^n Rz(alpha).
     const Vec3 euler_b(cfg.euler_b_rad[0], cfg.euler_b_rad[1], cfg.euler_b_rad[2]);
@@ -339,6 +365,7 @@ void Firmware::init(const pyins_config& raw) {
         prm.dt = dt_;
         pmath::sincos(cfg.lat_rad, &prm.sin_lat, &prm.cos_lat);
         prm.gravity = earth::normal_gravity(prm.sin_lat, cfg.height_m);
+        prm.settle_from = cfg.coarse_ticks - cfg.coarse_ticks / 5;
         coarse_align::init(coarse_, prm);
     }
     indexing::Params& ip = index_prm_;
@@ -400,26 +427,29 @@ void Firmware::update_rates(const Vec3& dtheta_p, double dalpha) {
     }
 }
 
-Vec3 Firmware::lever_p() const {
-    // Rz(alpha)^T lever_b + lever_p, alpha = the encoder angle, from its
-    // cached half-angle (cos a = c^2 - s^2, sin a = 2 s c).
+Vec3 Firmware::lever_b_in_p() const {
+    // Rz(alpha)^T lever_b, alpha = the encoder angle, from its cached
+    // half-angle (cos a = c^2 - s^2, sin a = 2 s c).
     const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
     const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
     const double* lb = cfg_.lever_b_m;
-    const double* lp = cfg_.lever_p_m;
-    return Vec3(ca * lb[0] + sa * lb[1] + lp[0], -sa * lb[0] + ca * lb[1] + lp[1], lb[2] + lp[2]);
+    return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
+}
+
+Vec3 Firmware::lever_p() const {
+    return lever_b_in_p() + Vec3(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
 }
 
 Vec3 Firmware::lever_vel_p() const {
+    return lever_vel_for(rate_p_, alpha_rate_);
+}
+
+Vec3 Firmware::lever_vel_for(const Vec3& rate_p, double alpha_rate) const {
     // u^p = (w_ip^p - alpha' z) x (Rz^T lever_b) + w_ip^p x lever_p: the table
     // centre moves with the ship (w_ib, in p), the sensor offset with the IMU.
-    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
-    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
-    const double* lb = cfg_.lever_b_m;
-    const Vec3 lb_p(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
     const Vec3 lp(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
-    const Vec3 w_b = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
-    return attitude::cross(w_b, lb_p) + attitude::cross(rate_p_, lp);
+    const Vec3 w_b = rate_p - Vec3(0.0, 0.0, alpha_rate);
+    return attitude::cross(w_b, lever_b_in_p()) + attitude::cross(rate_p, lp);
 }
 
 Vec3 Firmware::lever_vel_e_n(const Mat3& mat_np) const {
@@ -448,6 +478,57 @@ void Firmware::place_imu(double lat, double lon, double height, const Vec3& vel_
     if (sd_.vertical == strapdown::Vertical::kHold) {
         nav.vel_n(2) = 0.0;
         sd_.ref_height = nav.height;
+    }
+}
+
+void Firmware::reference_point(double* lat, double* lon, double* height, Vec3* vel_n) const {
+    const strapdown::NavState& nav = sd_.nav;
+    const Mat3 mat_np = attitude::quat_to_mat(nav.quat_np);
+    const Vec3 d = mat_np * lever_p();
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(nav.lat, &sin_lat, &cos_lat);
+    const earth::PrincipalRadii r = earth::principal_radii(sin_lat);
+    *vel_n = nav.vel_n - lever_vel_e_n(mat_np);
+    *lat = nav.lat - d(1) / (r.rm + nav.height);
+    *lon = wrap_pi(nav.lon - d(0) / ((r.rn + nav.height) * cos_lat));
+    *height = nav.height - d(2);
+}
+
+void Firmware::moving_fine(const Vec3& dtheta_p, const Vec3& dv_p) {
+    // The strapdown runs free in the horizontal (vertical held); every
+    // meas_every ticks the reference point's offset from the site is the
+    // measurement (moving_align.hpp), then attitude, velocity and position
+    // are corrected.
+    const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
+    double z[2] = {0.0, 0.0};
+    if (moving_align::measure(moving_)) {
+        double lat = sd_.nav.lat;
+        double lon = sd_.nav.lon;
+        double height = sd_.nav.height;
+        Vec3 vel = sd_.nav.vel_n;
+        if (has_lever_ != 0) {
+            reference_point(&lat, &lon, &height, &vel);
+        }
+        z[0] = wrap_pi(lon - sd_.ref_lon) * moving_.prm.rn_h * moving_.prm.cos_lat;
+        z[1] = (lat - cfg_.lat_rad) * moving_.prm.rm_h;
+    }
+    const bool updated = moving_align::step(moving_, dv_sf_n, z);
+    if (!moving_.healthy) {
+        faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
+    }
+    if (!moving_.consistent) {
+        faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
+        integrity_lost_ = 1;
+    }
+    if (updated) {
+        // feedback in both correction modes: the free horizontal channels
+        // need their velocity and position corrected to stay linear
+        apply_fine_correction();
+    }
+    fine_tick_ = fine_tick_ + 1;
+    if (fine_tick_ == cfg_.fine_ticks) {
+        end_fine();
     }
 }
 
@@ -490,14 +571,38 @@ void Firmware::start_fine() {
     prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
     prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
+    prm.nis_window = cfg_.integrity_nis_window > 0 ? cfg_.integrity_nis_window : 0;
+    prm.nis_max = cfg_.integrity_nis_max;
     kf_states_ = cfg_.fine_states;
     fine_tick_ = 0;
+    if (kf_states_ == 12) {
+        moving_align::Params mp;
+        mp.sin_lat = prm.sin_lat;
+        mp.cos_lat = prm.cos_lat;
+        const earth::PrincipalRadii r = earth::principal_radii(prm.sin_lat);
+        mp.rm_h = r.rm + cfg_.height_m;
+        mp.rn_h = r.rn + cfg_.height_m;
+        mp.dt = dt_;
+        mp.meas_every = cfg_.fine_meas_every_ticks;
+        mp.gyro_arw = cfg_.fine_gyro_arw;
+        mp.accel_vrw = cfg_.fine_accel_vrw;
+        mp.pos_sigma = cfg_.fine_pos_sigma_m;
+        mp.sigma0_att[0] = cfg_.fine_sigma0_att_rad[0];
+        mp.sigma0_att[1] = cfg_.fine_sigma0_att_rad[1];
+        mp.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
+        mp.sigma0_vel = cfg_.fine_sigma0_vel_mps;
+        mp.sigma0_gyro = cfg_.fine_sigma0_gyro;
+        mp.sigma0_accel = cfg_.fine_sigma0_accel;
+        mp.nis_window = prm.nis_window;
+        mp.nis_max = prm.nis_max;
+        moving_align::init(moving_, mp);
+    }
     if (has_lever_ != 0) {
         lever_vel_n_ = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
     }
     if (kf_states_ == 8) {
         fine_align::init<8>(fine8_, prm);
-    } else {
+    } else if (kf_states_ == 5) {
         fine_align::init<5>(fine5_, prm);
     }
     mode_ = Mode::kFineAlign;
@@ -506,6 +611,10 @@ void Firmware::start_fine() {
 Vec3 Firmware::fine_phi() const {
     if (mode_ != Mode::kFineAlign) {
         return Vec3::Zero();
+    }
+    if (kf_states_ == 12) {
+        return Vec3(moving_.x(moving_align::kPhi), moving_.x(moving_align::kPhi + 1),
+                    moving_.x(moving_align::kPhi + 2));
     }
     return kf_states_ == 8 ? fine_align::phi<8>(fine8_) : fine_align::phi<5>(fine5_);
 }
@@ -522,7 +631,18 @@ void Firmware::apply_fine_correction() {
         // feedback loop that turns 1' of heading into 40 ug and diverges)
         lever_vel_n_ = attitude::quat_to_mat(q_phi) * lever_vel_n_;
     }
-    if (kf_states_ == 8) {
+    if (kf_states_ == 12) {
+        // velocity and position too (the moving-base filter's feedback)
+        const double* x = moving_.x.data();
+        double sin_lat;
+        double cos_lat;
+        pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
+        sd_.nav.vel_n(0) = sd_.nav.vel_n(0) - x[moving_align::kVel];
+        sd_.nav.vel_n(1) = sd_.nav.vel_n(1) - x[moving_align::kVel + 1];
+        sd_.nav.lat = sd_.nav.lat - x[moving_align::kPos + 1] / moving_.prm.rm_h;
+        sd_.nav.lon = wrap_pi(sd_.nav.lon - x[moving_align::kPos] / (moving_.prm.rn_h * cos_lat));
+        moving_align::reset_feedback(moving_);
+    } else if (kf_states_ == 8) {
         fine_align::reset_phi<8>(fine8_);
     } else {
         fine_align::reset_phi<5>(fine5_);
@@ -532,7 +652,7 @@ void Firmware::apply_fine_correction() {
 void Firmware::end_fine() {
     // Navigation starts from the corrected attitude (both correction modes).
     apply_fine_correction();
-    if (has_lever_ != 0) {
+    if (has_lever_ != 0 && kf_states_ != 12) {
         place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
     }
     start_navigation();
@@ -723,12 +843,7 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
             lever_refine_ = 0;
             const Vec3 dw = (prev_dtheta_ - dtheta_p) / (2.0 * dt_);
             const double dwa = (prev_dalpha_ - dalpha) / (2.0 * dt_);
-            const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
-            const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
-            const double* lb = cfg_.lever_b_m;
-            const Vec3 lb_p(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
-            const Vec3 lp(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
-            const Vec3 du = attitude::cross(dw - Vec3(0.0, 0.0, dwa), lb_p) + attitude::cross(dw, lp);
+            const Vec3 du = lever_vel_for(dw, dwa);   // u is linear in the rates
             Vec3 dvel = attitude::quat_to_mat(sd_.nav.quat_np) * du;
             if (sd_.vertical == strapdown::Vertical::kHold) {
                 dvel(2) = 0.0;
@@ -775,9 +890,15 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     if (mode_ == Mode::kCoarseAlign) {
         coarse_align::update(coarse_, dtheta_p, dv_p,
                              has_lever_ != 0 ? lever_vel_p() : Vec3::Zero());
+        if (coarse_.wander > coarse_wander_max_) {
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_COARSE_UNSETTLED);
+            integrity_lost_ = 1;
+        }
         if (coarse_.tick == cfg_.coarse_ticks) {
             end_coarse();
         }
+    } else if (mode_ == Mode::kFineAlign && kf_states_ == 12) {
+        moving_fine(dtheta_p, dv_p);
     } else if (mode_ == Mode::kFineAlign) {
         // Attitude by the strapdown; position and velocity held (static base).
         Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
@@ -806,6 +927,10 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
         }
         if (!healthy) {
             faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
+        }
+        if (!(kf_states_ == 8 ? fine8_.consistent : fine5_.consistent)) {
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
+            integrity_lost_ = 1;
         }
         if (updated && cfg_.fine_correction == PYINS_FINE_FEEDBACK) {
             apply_fine_correction();
@@ -838,16 +963,8 @@ void Firmware::output(pyins_output* out) const {
     out->vel_n_mps[2] = nav.vel_n(2);
     if (has_lever_ != 0 && (mode_ == Mode::kFineAlign || mode_ == Mode::kNavigate)) {
         // The state is the accelerometers'; the record the reference point's.
-        const Mat3 mat_np = attitude::quat_to_mat(nav.quat_np);
-        const Vec3 d = mat_np * lever_p();
-        double sin_lat;
-        double cos_lat;
-        pmath::sincos(nav.lat, &sin_lat, &cos_lat);
-        const earth::PrincipalRadii r = earth::principal_radii(sin_lat);
-        const Vec3 vel = nav.vel_n - lever_vel_e_n(mat_np);
-        out->lat_rad = nav.lat - d(1) / (r.rm + nav.height);
-        out->lon_rad = wrap_pi(nav.lon - d(0) / ((r.rn + nav.height) * cos_lat));
-        out->height_m = nav.height - d(2);
+        Vec3 vel;
+        reference_point(&out->lat_rad, &out->lon_rad, &out->height_m, &vel);
         out->vel_n_mps[0] = vel(0);
         out->vel_n_mps[1] = vel(1);
         // a held vertical channel holds the reference point too
@@ -861,13 +978,22 @@ void Firmware::output(pyins_output* out) const {
     bool valid = att_valid_;
     if (mode_ == Mode::kCoarseAlign && coarse_.solved) {
         q_np = attitude::mat_to_quat(coarse_align::mat_n_p(coarse_));
-        valid = true;
+        // provisional: the coarse attitude is valid once the alignment has
+        // ended and its wander test passed (a wrong solution can look
+        // settled early in the test's window)
+        valid = false;
     } else if (mode_ == Mode::kFineAlign) {
-        // the best estimate: the propagated attitude corrected by phi^
+        // the best estimate: the propagated attitude corrected by phi^,
+        // provisional until the first NIS window has passed
         q_np = attitude::quat_normalize(
             attitude::quat_mul(attitude::rotvec_to_quat(fine_phi()), nav.quat_np));
+        const int32_t windows = kf_states_ == 12 ? moving_.nis_windows
+                                : (kf_states_ == 8 ? fine8_.nis_windows : fine5_.nis_windows);
+        if (cfg_.integrity_nis_window > 0 && windows == 0) {
+            valid = false;
+        }
     }
-    out->state_flags = valid ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
+    out->state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
     const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(q_np, q_pb));
     const Vec3 euler_b = attitude::quat_to_euler(q_nb);
     out->quat_nb[0] = q_nb.w;
@@ -900,6 +1026,9 @@ void Firmware::output(pyins_output* out) const {
     out->n_seq_lost = counts_.seq_lost;
     out->n_encoder_jumps = counts_.encoder_jumps;
     out->seq = seq_;
+    out->align_nis = kf_states_ == 12 ? moving_.nis_mean
+                     : (kf_states_ == 8 ? fine8_.nis_mean : (kf_states_ == 5 ? fine5_.nis_mean : 0.0));
+    out->coarse_wander_rad = cfg_.coarse_ticks > 0 ? coarse_.wander : 0.0;
     out->kf_states = kf_states_;
     out->align_restarts = align_restarts_;
     for (int i = 0; i < 8; ++i) {
@@ -915,6 +1044,14 @@ void Firmware::output(pyins_output* out) const {
         for (int i = 0; i < 5; ++i) {
             out->kf_x[i] = fine5_.x(i);
             out->kf_sigma[i] = pmath::sqrt(fine5_.p(i, i));
+        }
+    } else if (kf_states_ == 12) {
+        // [phi, eps, nabla_E, nabla_N]: the 8-state filter's layout
+        const int idx[8] = {0, 1, 2, moving_align::kEps, moving_align::kEps + 1, moving_align::kEps + 2,
+                            moving_align::kNabla, moving_align::kNabla + 1};
+        for (int i = 0; i < 8; ++i) {
+            out->kf_x[i] = moving_.x(idx[i]);
+            out->kf_sigma[i] = pmath::sqrt(moving_.p(idx[i], idx[i]));
         }
     }
 }

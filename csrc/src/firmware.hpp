@@ -12,6 +12,7 @@
 #include "coarse_align.hpp"
 #include "fine_align.hpp"
 #include "indexing.hpp"
+#include "moving_align.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 
@@ -31,11 +32,20 @@ inline constexpr double kDefaultCoarseRatio = 0.5;
 /// Fine alignment defaults (seed 001 sec. 3.3; SPEC.md).
 inline constexpr int32_t kDefaultFineStates = 5;
 inline constexpr int32_t kDefaultFineMeasEvery = 10;             ///< 10 Hz updates at 100 Hz
+inline constexpr int32_t kDefaultMovingMeasEverySecond = 1;      ///< moving base: 1 Hz position updates
+inline constexpr double kDefaultPosSigma = 0.5;                  ///< [m]: a moored ship's surge and sway
+inline constexpr double kDefaultSigma0Vel = 0.5;                 ///< [m/s]: its wave velocity at the start
 inline constexpr double kDefaultFineArw = 0.001 * (3.14159265358979323846 / 180.0) / 60.0;  ///< 0.001 deg/sqrt(h)
 inline constexpr double kDefaultFineVrw = 10.0e-6 * 9.80665;   ///< 10 ug/sqrt(Hz)
 inline constexpr double kArcminRad = 3.14159265358979323846 / 180.0 / 60.0;
 inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminRad, 100.0 * kArcminRad,
                                                    600.0 * kArcminRad};  ///< 10 x [10', 10', 60']
+/// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
+/// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
+/// tools/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
+/// heading let the wave noise swing the early heading by 80' (measured).
+inline constexpr double kDefaultMovingSigmaAtt[3] = {1.0 * kArcminRad, 1.0 * kArcminRad,
+                                                     10.0 * kArcminRad};
 inline constexpr double kDefaultFineSigmaGyro = 0.01 * (3.14159265358979323846 / 180.0) / 3600.0;
 inline constexpr double kDefaultFineSigmaAccel = 100.0e-6 * 9.80665;  ///< 100 ug (not in seed 001)
 /// Indexing defaults (seeds 002, 003: 6 deg/s; stops 60 s in seed 003, 300 s in seed 002).
@@ -65,6 +75,14 @@ inline constexpr int32_t kMaxSeqGap = 100;
 /// Longest lever arm accepted [m]: a ship's IMU is metres from its reference
 /// point; beyond 100 m the number is a unit mistake (mm or inches).
 inline constexpr double kMaxLeverM = 100.0;
+/// Integrity defaults (docs/concepts.md, "Integrity"): 100 updates (10 s at
+/// 10 Hz) per NIS window and a bound of 4 on its mean (10 sigma of a
+/// consistent window); the coarse solution may wander 30' over its last
+/// fifth (measured on the moored ship with seed 000's errors: FIT over 120 s
+/// wanders 2.7-10.9', over 300 s < 1.5'; TRIAD over 300 s 164-326').
+inline constexpr int32_t kDefaultNisWindow = 100;
+inline constexpr double kDefaultNisMax = 4.0;
+inline constexpr double kDefaultCoarseWander = 30.0 * kArcminRad;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -155,14 +173,23 @@ class Firmware {
     /// Lever arm (docs/concepts.md, "Lever arms"): rate estimates at the end
     /// of this tick from its increments and the last tick's.
     void update_rates(const Vec3& dtheta_p, double dalpha);
+    /// Rz(alpha)^T lever_b: the table centre from the reference point, in p [m].
+    Vec3 lever_b_in_p() const;
     /// r^p = Rz(alpha)^T lever_b + lever_p: reference point -> accelerometers, in p [m].
     Vec3 lever_p() const;
+    /// u^p for the rates given (linear in them).
+    Vec3 lever_vel_for(const Vec3& rate_p, double alpha_rate) const;
     /// u^p = d/dt (C_p^i r^p) in p: the accelerometers' velocity relative to
     /// the reference point, inertial derivative [m/s].
     Vec3 lever_vel_p() const;
     /// Earth-relative velocity of the accelerometers relative to the
     /// reference point, in n: C_p^n u^p - w_ie^n x C_p^n r^p [m/s].
     Vec3 lever_vel_e_n(const Mat3& mat_np) const;
+    /// The reference point's position and velocity from the navigation
+    /// state (the accelerometers') and the lever arm.
+    void reference_point(double* lat, double* lon, double* height, Vec3* vel_n) const;
+    /// One tick of the moving-base fine alignment (fine_states = 12).
+    void moving_fine(const Vec3& dtheta_p, const Vec3& dv_p);
     /// Put the navigation state on the accelerometers of a reference point
     /// at (lat, lon, height) moving with vel_n, with the current attitude.
     void place_imu(double lat, double lon, double height, const Vec3& vel_n);
@@ -176,6 +203,7 @@ class Firmware {
     coarse_align::CoarseAlign coarse_;
     fine_align::FineAlign<5> fine5_;
     fine_align::FineAlign<8> fine8_;
+    moving_align::MovingAlign moving_;
     int32_t kf_states_;           ///< 0 until fine alignment starts, then 5 or 8
     int32_t fine_tick_;           ///< samples taken in fine alignment
     int32_t align_restarts_;      ///< alignments restarted after a rejected sample
@@ -203,7 +231,8 @@ class Firmware {
     double prev_dalpha_;          ///< table angle change over the last tick advanced [rad]
     Vec3 lever_vel_n_;            ///< C_p^n u^p at the last fine-alignment tick [m/s]
     int32_t lever_refine_;        ///< 1: navigation started from the configured state last tick
-    int32_t reserved_lever_;      ///< padding, keep 0
+    int32_t integrity_lost_;      ///< 1: an integrity test failed: the attitude is never valid again
+    double coarse_wander_max_;    ///< sine of integrity_coarse_rad
 };
 
 }  // namespace pyins::firmware

@@ -29,18 +29,25 @@ void predict(Vec<N>& x, Mat<N, N>& p, const Mat<N, N>& phi, const Mat<N, N>& qd)
 ///   K = P H^T (H P H^T + R)^-1,  x <- x + K (z - H x),
 ///   P <- (I - K H) P (I - K H)^T + K R K^T, symmetrised.
 /// The innovation covariance is inverted in closed form for M = 2.
+/// Returns the normalised innovation squared nu^T S^-1 nu, nu = z - H x,
+/// S = H P H^T + R: chi-square with 2 degrees of freedom (mean 2) while the
+/// model holds (Bar-Shalom, Li, Kirubarajan, "Estimation with Applications
+/// to Tracking and Navigation", 2001, sec. 5.4).
 template <int N>
-void update2(Vec<N>& x, Mat<N, N>& p, const Mat<2, N>& h, const Vec<2>& z, const Mat<2, 2>& r) {
+double update2(Vec<N>& x, Mat<N, N>& p, const Mat<2, N>& h, const Vec<2>& z, const Mat<2, 2>& r) {
     const Mat<2, 2> s = h * p * h.transpose() + r;
     const double det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
     Mat<2, 2> s_inv;
     s_inv << s(1, 1) / det, -s(0, 1) / det,
              -s(1, 0) / det, s(0, 0) / det;
     const Mat<N, 2> k = p * h.transpose() * s_inv;
-    x = x + k * (z - h * x);
+    const Vec<2> nu = z - h * x;
+    const double nis = nu.dot(s_inv * nu);
+    x = x + k * nu;
     const Mat<N, N> ikh = Mat<N, N>::Identity() - k * h;
     const Mat<N, N> pj = ikh * p * ikh.transpose() + k * r * k.transpose();
     p = 0.5 * (pj + pj.transpose());
+    return nis;
 }
 
 /// True when every diagonal element is finite and positive.

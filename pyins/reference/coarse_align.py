@@ -28,6 +28,7 @@ class Params:
     sin_lat: float
     cos_lat: float
     gravity: float
+    settle_from: int = 0
 
 
 @dataclass
@@ -41,8 +42,12 @@ class CoarseAlign:
     pos_ib0: np.ndarray = field(default_factory=lambda: np.zeros(3))
     lever_vel0: np.ndarray = field(default_factory=lambda: np.zeros(3))
     grid: list = field(default_factory=lambda: [np.zeros(3)])
+    grid_every: int = 0   #: set to prm.output_every at the first update
     mat_i_ib0: np.ndarray = field(default_factory=lambda: np.eye(3))
     solved: bool = False
+    settling: bool = False
+    settle_ref: np.ndarray = field(default_factory=lambda: np.eye(3))
+    wander: float = 0.0
 
 
 def vel_i(t, sin_lat, cos_lat, gravity):
@@ -142,8 +147,32 @@ def mat_e_i(t):
     return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def rotation_sine(a, b):
+    """Sine of the rotation angle between two rotation matrices, 1 beyond 90 deg."""
+    r = a.T @ b
+    if r[0, 0] + r[1, 1] + r[2, 2] < 1.0:
+        return 1.0
+    x = 0.5 * (r[2, 1] - r[1, 2])
+    y = 0.5 * (r[0, 2] - r[2, 0])
+    z = 0.5 * (r[1, 0] - r[0, 1])
+    return float(np.sqrt(x * x + y * y + z * z))
+
+
 def init(prm):
     return CoarseAlign(prm=prm)
+
+
+def settle(a):
+    """The wander test on a new solution (mirrors settle)."""
+    if a.tick < a.prm.settle_from:
+        return
+    if not a.settling:
+        a.settling = True
+        a.settle_ref = a.mat_i_ib0.copy()
+        return
+    s = rotation_sine(a.settle_ref, a.mat_i_ib0)
+    if s > a.wander:
+        a.wander = s
 
 
 def update(a, dtheta_p, dv_p, lever_vel_p=None):
@@ -169,13 +198,20 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
         a.vel_prev = vel.copy()
 
     every = a.prm.output_every
-    if a.tick % every == 0 and len(a.grid) < HIST_LEN:
+    if a.grid_every == 0:
+        a.grid_every = every
+    if fit and a.tick % a.grid_every == 0 and len(a.grid) == HIST_LEN:
+        # full: every other point at twice the spacing (mirrors update)
+        a.grid = a.grid[0:HIST_LEN:2]
+        a.grid_every = 2 * a.grid_every
+    if a.tick % a.grid_every == 0 and len(a.grid) < HIST_LEN:
         a.grid.append(a.pos_ib0.copy() if fit else vel.copy())
     if a.tick >= a.prm.first_output and (a.tick - a.prm.first_output) % every == 0:
         if fit:
-            a.mat_i_ib0 = solve_fit(a.grid, len(a.grid), float(every) * a.prm.dt,
+            a.mat_i_ib0 = solve_fit(a.grid, len(a.grid), float(a.grid_every) * a.prm.dt,
                                     a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity)
             a.solved = True
+            settle(a)
             return
         k1 = int(a.prm.ratio * float(a.tick) / float(every) + 0.5)
         k1 = min(k1, (a.tick - 1) // every)
@@ -191,6 +227,7 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
             vb2 = vb2 + a.lever_vel0
         a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2)
         a.solved = True
+        settle(a)
 
 
 def mat_n_p(a):

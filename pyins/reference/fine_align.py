@@ -22,6 +22,8 @@ class Params:
     sigma0_att: np.ndarray
     sigma0_gyro: float
     sigma0_accel: float
+    nis_window: int = 0
+    nis_max: float = 0.0
 
 
 @dataclass
@@ -38,6 +40,13 @@ class FineAlign:
     meas_every: int
     meas_span: float
     healthy: bool
+    consistent: bool = True
+    nis_window: int = 0
+    nis_max: float = 0.0
+    nis_sum: float = 0.0
+    nis_count: int = 0
+    nis_mean: float = 0.0
+    nis_windows: int = 0
 
 
 def system_matrix(n, sin_lat, cos_lat):
@@ -82,7 +91,8 @@ def init(n, prm):
     p = np.diag(sigma * sigma)
     return FineAlign(n=n, x=np.zeros(n), p=p, phi=phi, qd=qd, h=h, r=r, dv_sum=np.zeros(3),
                      meas_count=0, meas_every=prm.meas_every,
-                     meas_span=float(prm.meas_every) * prm.dt, healthy=True)
+                     meas_span=float(prm.meas_every) * prm.dt, healthy=True,
+                     nis_window=prm.nis_window, nis_max=prm.nis_max)
 
 
 def step(f, dv_sf_n):
@@ -93,9 +103,18 @@ def step(f, dv_sf_n):
     updated = f.meas_count == f.meas_every
     if updated:
         z = np.array([f.dv_sum[0] / f.meas_span, f.dv_sum[1] / f.meas_span])
-        f.x, f.p = kalman.update2(f.x, f.p, f.h, z, f.r)
+        f.x, f.p, nis = kalman.update2(f.x, f.p, f.h, z, f.r)
         f.dv_sum = np.zeros(3)
         f.meas_count = 0
+        if f.nis_window > 0:
+            f.nis_sum = f.nis_sum + nis
+            f.nis_count = f.nis_count + 1
+            if f.nis_count == f.nis_window:
+                f.nis_mean = f.nis_sum / float(f.nis_window)
+                f.nis_windows = f.nis_windows + 1
+                f.consistent = f.consistent and f.nis_mean <= f.nis_max
+                f.nis_sum = 0.0
+                f.nis_count = 0
     f.healthy = f.healthy and kalman.diagonal_positive(f.p)
     return updated
 

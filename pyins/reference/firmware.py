@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from . import attitude, coarse_align, earth, fine_align, indexing, strapdown
+from . import attitude, coarse_align, earth, fine_align, indexing, moving_align, strapdown
 from .attitude import cross
 
 # Status codes: pinned values of enum pyins_status.
@@ -51,6 +51,7 @@ PYINS_E_CONFIG_SEQ = -33
 PYINS_E_CONFIG_INDEX_SUMS = -34
 PYINS_E_CONFIG_LEVER = -35
 PYINS_E_CONFIG_COARSE_METHOD = -36
+PYINS_E_CONFIG_INTEGRITY = -37
 PYINS_W_SEQ_GAP = 1          #: notices: the sample was handled (docs/core.md)
 PYINS_W_SEQ_REPEAT = 2
 PYINS_W_SEQ_LOST = 3
@@ -69,6 +70,8 @@ FAULT_SEQ_GAP = 16           #: PYINS_FAULT_SEQ_GAP
 FAULT_SEQ_REPEAT = 32        #: PYINS_FAULT_SEQ_REPEAT
 FAULT_SEQ_LOST = 64          #: PYINS_FAULT_SEQ_LOST
 FAULT_ENCODER_JUMP = 128     #: PYINS_FAULT_ENCODER_JUMP
+FAULT_ALIGN_INCONSISTENT = 256   #: PYINS_FAULT_ALIGN_INCONSISTENT
+FAULT_COARSE_UNSETTLED = 512     #: PYINS_FAULT_COARSE_UNSETTLED
 
 SEQ_OFF = 0                  #: PYINS_SEQ_OFF
 SEQ_CHECK = 1                #: PYINS_SEQ_CHECK
@@ -87,10 +90,16 @@ DEFAULT_COARSE_EVERY_S = 1      #: kDefaultCoarseEveryS
 DEFAULT_COARSE_RATIO = 0.5      #: kDefaultCoarseRatio
 DEFAULT_FINE_STATES = 5         #: kDefaultFineStates
 DEFAULT_FINE_MEAS_EVERY = 10    #: kDefaultFineMeasEvery
+DEFAULT_MOVING_MEAS_EVERY_SECOND = 1   #: kDefaultMovingMeasEverySecond
+DEFAULT_POS_SIGMA = 0.5         #: kDefaultPosSigma [m]
+DEFAULT_SIGMA0_VEL = 0.5        #: kDefaultSigma0Vel [m/s]
+DEFAULT_MOVING_SIGMA_ATT = (1.0 * (np.pi / 180.0 / 60.0), 1.0 * (np.pi / 180.0 / 60.0),
+                            10.0 * (np.pi / 180.0 / 60.0))   #: kDefaultMovingSigmaAtt
 DEFAULT_FINE_ARW = 0.001 * (np.pi / 180.0) / 60.0           #: kDefaultFineArw
 DEFAULT_FINE_VRW = 10.0e-6 * 9.80665                        #: kDefaultFineVrw
 ARCMIN_RAD = np.pi / 180.0 / 60.0                           #: kArcminRad
 DEFAULT_FINE_SIGMA_ATT = (100.0 * ARCMIN_RAD, 100.0 * ARCMIN_RAD, 600.0 * ARCMIN_RAD)
+DEFAULT_COARSE_WANDER = 30.0 * ARCMIN_RAD                   #: kDefaultCoarseWander
 DEFAULT_FINE_SIGMA_GYRO = 0.01 * (np.pi / 180.0) / 3600.0   #: kDefaultFineSigmaGyro
 DEFAULT_FINE_SIGMA_ACCEL = 100.0e-6 * 9.80665               #: kDefaultFineSigmaAccel
 DEG = np.pi / 180.0                                         #: kDeg
@@ -116,6 +125,8 @@ MAX_LAT_RAD = 89.9 * np.pi / 180.0   #: kMaxLatRad
 MAX_LEVER_M = 100.0            #: kMaxLeverM
 COARSE_TRIAD = coarse_align.METHOD_TRIAD   #: PYINS_COARSE_TRIAD
 COARSE_FIT = coarse_align.METHOD_FIT       #: PYINS_COARSE_FIT
+DEFAULT_NIS_WINDOW = 100                   #: kDefaultNisWindow
+DEFAULT_NIS_MAX = 4.0                      #: kDefaultNisMax
 
 TWO_PI = 2.0 * np.pi
 
@@ -166,6 +177,12 @@ def config_default():
         "lever_p_m": np.zeros(3),
         "coarse_method": COARSE_TRIAD,
         "reserved2": 0,
+        "integrity_nis_window": 0,
+        "reserved3": 0,
+        "integrity_nis_max": 0.0,
+        "integrity_coarse_rad": 0.0,
+        "fine_pos_sigma_m": 0.0,
+        "fine_sigma0_vel_mps": 0.0,
     }
 
 
@@ -183,7 +200,12 @@ def config_resolved(cfg):
     if cfg["fine_states"] == 0:
         cfg["fine_states"] = DEFAULT_FINE_STATES
     if cfg["fine_meas_every_ticks"] == 0:
-        cfg["fine_meas_every_ticks"] = DEFAULT_FINE_MEAS_EVERY
+        cfg["fine_meas_every_ticks"] = (DEFAULT_MOVING_MEAS_EVERY_SECOND * cfg["tick_hz"]
+                                        if cfg["fine_states"] == 12 else DEFAULT_FINE_MEAS_EVERY)
+    if cfg["fine_pos_sigma_m"] == 0.0:
+        cfg["fine_pos_sigma_m"] = DEFAULT_POS_SIGMA
+    if cfg["fine_sigma0_vel_mps"] == 0.0:
+        cfg["fine_sigma0_vel_mps"] = DEFAULT_SIGMA0_VEL
     if cfg["fine_gyro_arw"] == 0.0:
         cfg["fine_gyro_arw"] = DEFAULT_FINE_ARW
     if cfg["fine_accel_vrw"] == 0.0:
@@ -191,7 +213,7 @@ def config_resolved(cfg):
     sig = np.array(cfg["fine_sigma0_att_rad"], dtype=float)
     for i in range(3):
         if sig[i] == 0.0:
-            sig[i] = DEFAULT_FINE_SIGMA_ATT[i]
+            sig[i] = DEFAULT_MOVING_SIGMA_ATT[i] if cfg["fine_states"] == 12 else DEFAULT_FINE_SIGMA_ATT[i]
     cfg["fine_sigma0_att_rad"] = sig
     if cfg["fine_sigma0_gyro"] == 0.0:
         cfg["fine_sigma0_gyro"] = DEFAULT_FINE_SIGMA_GYRO
@@ -221,6 +243,12 @@ def config_resolved(cfg):
         cfg["sat_gyro_rad"] = DEFAULT_SAT_GYRO_RATE / float(cfg["tick_hz"])
     if cfg["sat_accel_mps"] == 0.0:
         cfg["sat_accel_mps"] = DEFAULT_SAT_ACCEL / float(cfg["tick_hz"])
+    if cfg["integrity_nis_window"] == 0:
+        cfg["integrity_nis_window"] = DEFAULT_NIS_WINDOW
+    if cfg["integrity_nis_max"] == 0.0:
+        cfg["integrity_nis_max"] = DEFAULT_NIS_MAX
+    if cfg["integrity_coarse_rad"] == 0.0:
+        cfg["integrity_coarse_rad"] = DEFAULT_COARSE_WANDER
     return cfg
 
 
@@ -287,15 +315,17 @@ def config_check(raw):
             return PYINS_E_CONFIG_ALIGN_TICKS
         if cfg["coarse_ratio"] * float(cfg["coarse_first_output_ticks"]) < float(every):
             return PYINS_E_CONFIG_ALIGN_EARLY
-        if cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1:
+        if (cfg["coarse_method"] == COARSE_TRIAD
+                and cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1):
             return PYINS_E_CONFIG_ALIGN_LONG
     if cfg["fine_ticks"] < 0:
         return PYINS_E_CONFIG_ALIGN_TICKS
-    if (cfg["fine_states"] not in (5, 8) or cfg["fine_meas_every_ticks"] < 0
+    if (cfg["fine_states"] not in (5, 8, 12) or cfg["fine_meas_every_ticks"] < 0
             or cfg["fine_correction"] not in (FINE_FEEDBACK, FINE_OPEN_LOOP)):
         return PYINS_E_CONFIG_FINE
     noise = [cfg["fine_gyro_arw"], cfg["fine_accel_vrw"], *cfg["fine_sigma0_att_rad"],
-             cfg["fine_sigma0_gyro"], cfg["fine_sigma0_accel"]]
+             cfg["fine_sigma0_gyro"], cfg["fine_sigma0_accel"], cfg["fine_pos_sigma_m"],
+             cfg["fine_sigma0_vel_mps"]]
     for v in noise:
         if not (v > 0.0) or not math.isfinite(v):
             return PYINS_E_CONFIG_NOISE
@@ -318,6 +348,10 @@ def config_check(raw):
             and cfg["coarse_first_output_ticks"] // cfg["coarse_output_every_ticks"]
             < coarse_align.FIT_MIN_INTERVALS):
         return PYINS_E_CONFIG_ALIGN_EARLY
+    nis_max, wander = cfg["integrity_nis_max"], cfg["integrity_coarse_rad"]
+    if (cfg["integrity_nis_window"] < -1 or not (nis_max > 0.0) or not math.isfinite(nis_max)
+            or not (wander > 0.0) or not math.isfinite(wander)):
+        return PYINS_E_CONFIG_INTEGRITY
     return PYINS_OK
 
 
@@ -399,6 +433,9 @@ class Firmware:
         self.prev_dalpha = 0.0
         self.lever_vel_n = np.zeros(3)
         self.lever_refine = 0
+        self.integrity_lost = 0
+        wander = cfg["integrity_coarse_rad"]
+        self.coarse_wander_max = 1.0 if wander >= 0.5 * np.pi else math.sin(wander)
         euler_b = np.array(cfg["euler_b_rad"], dtype=float)
         mat_np = attitude.euler_to_mat(euler_b) @ attitude.rot_z(self.encoder)
         lon = cfg["lon_rad"]
@@ -426,7 +463,8 @@ class Firmware:
             prm = coarse_align.Params(
                 method=cfg["coarse_method"], lever=self.has_lever, ratio=cfg["coarse_ratio"], first_output=cfg["coarse_first_output_ticks"],
                 output_every=cfg["coarse_output_every_ticks"], dt=self.dt, sin_lat=sin_lat,
-                cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]))
+                cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
+                settle_from=cfg["coarse_ticks"] - cfg["coarse_ticks"] // 5)
             self.coarse = coarse_align.init(prm)
 
     def end_coarse(self):
@@ -451,12 +489,22 @@ class Firmware:
             sin_lat=sin_lat, cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
             dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
             accel_vrw=cfg["fine_accel_vrw"], sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
-            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
+            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
+            nis_window=max(cfg["integrity_nis_window"], 0), nis_max=cfg["integrity_nis_max"])
         self.kf_states = cfg["fine_states"]
         self.fine_tick = 0
+        if self.kf_states == 12:
+            rm, rn = earth.principal_radii(sin_lat)
+            mp = moving_align.Params(
+                sin_lat=sin_lat, cos_lat=cos_lat, rm_h=rm + cfg["height_m"], rn_h=rn + cfg["height_m"],
+                dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
+                accel_vrw=cfg["fine_accel_vrw"], pos_sigma=cfg["fine_pos_sigma_m"],
+                sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
+                sigma0_vel=cfg["fine_sigma0_vel_mps"], sigma0_gyro=cfg["fine_sigma0_gyro"],
+                sigma0_accel=cfg["fine_sigma0_accel"], nis_window=prm.nis_window, nis_max=prm.nis_max)
         if self.has_lever:
             self.lever_vel_n = attitude.quat_to_mat(self.sd.nav.quat_np) @ self.lever_vel_p()
-        self.fine = fine_align.init(self.kf_states, prm)
+        self.fine = moving_align.init(mp) if self.kf_states == 12 else fine_align.init(self.kf_states, prm)
         self.mode = MODE_FINE_ALIGN
 
     def fine_phi(self):
@@ -472,11 +520,21 @@ class Firmware:
         if self.has_lever:
             # the lever velocity in n turns with the attitude (see firmware.cpp)
             self.lever_vel_n = attitude.quat_to_mat(q_phi) @ self.lever_vel_n
-        fine_align.reset_phi(self.fine)
+        if self.kf_states == 12:
+            x = self.fine.x
+            nav = self.sd.nav
+            cos_lat = np.cos(nav.lat)
+            nav.vel_n[0] = nav.vel_n[0] - x[moving_align.VEL]
+            nav.vel_n[1] = nav.vel_n[1] - x[moving_align.VEL + 1]
+            nav.lat = nav.lat - x[moving_align.POS + 1] / self.fine.prm.rm_h
+            nav.lon = wrap_pi(nav.lon - x[moving_align.POS] / (self.fine.prm.rn_h * cos_lat))
+            moving_align.reset_feedback(self.fine)
+        else:
+            fine_align.reset_phi(self.fine)
 
     def end_fine(self):
         self.apply_fine_correction()
-        if self.has_lever:
+        if self.has_lever and self.kf_states != 12:
             self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
         self.start_navigation()
 
@@ -517,9 +575,13 @@ class Firmware:
         return self._lever_b_p() + self.lever_pp
 
     def lever_vel_p(self):
-        """u^p = (w_ip^p - alpha' z) x Rz^T lever_b + w_ip^p x lever_p (mirrors lever_vel_p)."""
-        w_b = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
-        return cross(w_b, self._lever_b_p()) + cross(self.rate_p, self.lever_pp)
+        """u^p at the last tick's rates (mirrors lever_vel_p)."""
+        return self.lever_vel_for(self.rate_p, self.alpha_rate)
+
+    def lever_vel_for(self, rate_p, alpha_rate):
+        """u^p = (w_ip^p - alpha' z) x Rz^T lever_b + w_ip^p x lever_p (mirrors lever_vel_for)."""
+        w_b = rate_p - np.array([0.0, 0.0, alpha_rate])
+        return cross(w_b, self._lever_b_p()) + cross(rate_p, self.lever_pp)
 
     def lever_vel_e_n(self, mat_np):
         """C_p^n u^p - w_ie^n x C_p^n r^p (mirrors lever_vel_e_n)."""
@@ -541,6 +603,40 @@ class Firmware:
         if self.sd.vertical == strapdown.VERTICAL_HOLD:
             nav.vel_n[2] = 0.0
             self.sd.ref_height = nav.height
+
+    def reference_point(self):
+        """(lat, lon, height, vel_n) of the reference point (mirrors reference_point)."""
+        nav = self.sd.nav
+        mat_np = attitude.quat_to_mat(nav.quat_np)
+        d = mat_np @ self.lever_p()
+        sin_lat, cos_lat = np.sin(nav.lat), np.cos(nav.lat)
+        rm, rn = earth.principal_radii(sin_lat)
+        vel = nav.vel_n - self.lever_vel_e_n(mat_np)
+        lat = nav.lat - d[1] / (rm + nav.height)
+        lon = wrap_pi(nav.lon - d[0] / ((rn + nav.height) * cos_lat))
+        return lat, lon, nav.height - d[2], vel
+
+    def moving_fine(self, dtheta_p, dv_p):
+        """One tick of the moving-base fine alignment (mirrors moving_fine)."""
+        dv_sf_n = strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
+        z = (0.0, 0.0)
+        if moving_align.measure(self.fine):
+            lat, lon = self.sd.nav.lat, self.sd.nav.lon
+            if self.has_lever:
+                lat, lon, _, _ = self.reference_point()
+            z = (wrap_pi(lon - self.sd.ref_lon) * self.fine.prm.rn_h * self.fine.prm.cos_lat,
+                 (lat - self.cfg["lat_rad"]) * self.fine.prm.rm_h)
+        updated = moving_align.step(self.fine, dv_sf_n, z)
+        if not self.fine.healthy:
+            self.faults = self.faults | FAULT_KF_NOT_PD
+        if not self.fine.consistent:
+            self.faults = self.faults | FAULT_ALIGN_INCONSISTENT
+            self.integrity_lost = 1
+        if updated:
+            self.apply_fine_correction()
+        self.fine_tick = self.fine_tick + 1
+        if self.fine_tick == self.cfg["fine_ticks"]:
+            self.end_fine()
 
     def index_reset(self):
         if self.idx.state == indexing.STATE_FAULT:
@@ -670,7 +766,7 @@ class Firmware:
                 self.lever_refine = 0
                 dw = (self.prev_dtheta - dtheta_p) / (2.0 * self.dt)
                 dwa = (self.prev_dalpha - dalpha) / (2.0 * self.dt)
-                du = cross(dw - np.array([0.0, 0.0, dwa]), self._lever_b_p()) + cross(dw, self.lever_pp)
+                du = self.lever_vel_for(dw, dwa)   # u is linear in the rates
                 dvel = attitude.quat_to_mat(self.sd.nav.quat_np) @ du
                 if self.sd.vertical == strapdown.VERTICAL_HOLD:
                     dvel[2] = 0.0
@@ -706,8 +802,13 @@ class Firmware:
         if self.mode == MODE_COARSE_ALIGN:
             coarse_align.update(self.coarse, dtheta_p, dv_p,
                                 self.lever_vel_p() if self.has_lever else np.zeros(3))
+            if self.coarse.wander > self.coarse_wander_max:
+                self.faults = self.faults | FAULT_COARSE_UNSETTLED
+                self.integrity_lost = 1
             if self.coarse.tick == self.cfg["coarse_ticks"]:
                 self.end_coarse()
+        elif self.mode == MODE_FINE_ALIGN and self.kf_states == 12:
+            self.moving_fine(dtheta_p, dv_p)
         elif self.mode == MODE_FINE_ALIGN:
             dv_sf_n = strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
             self.hold_at_site()
@@ -720,6 +821,9 @@ class Firmware:
             updated = fine_align.step(self.fine, dv_sf_n)
             if not self.fine.healthy:
                 self.faults = self.faults | FAULT_KF_NOT_PD
+            if not self.fine.consistent:
+                self.faults = self.faults | FAULT_ALIGN_INCONSISTENT
+                self.integrity_lost = 1
             if updated and self.cfg["fine_correction"] == FINE_FEEDBACK:
                 self.apply_fine_correction()
             self.fine_tick = self.fine_tick + 1
@@ -738,29 +842,24 @@ class Firmware:
         valid = self.att_valid
         if self.mode == MODE_COARSE_ALIGN and self.coarse.solved:
             q_np = attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse))
-            valid = True
+            valid = False   # provisional until the alignment ends and its wander test passed
         elif self.mode == MODE_FINE_ALIGN:
             q_np = attitude.quat_normalize(
                 attitude.quat_mul(attitude.rotvec_to_quat(self.fine_phi()), nav.quat_np))
+            if self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0:
+                valid = False   # provisional until the first NIS window has passed
         q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
         lat, lon, height, vel = nav.lat, nav.lon, nav.height, nav.vel_n.copy()
         if self.has_lever and self.mode in (MODE_FINE_ALIGN, MODE_NAVIGATE):
-            mat_np = attitude.quat_to_mat(nav.quat_np)
-            d = mat_np @ self.lever_p()
-            sin_lat, cos_lat = np.sin(nav.lat), np.cos(nav.lat)
-            rm, rn = earth.principal_radii(sin_lat)
-            vel = nav.vel_n - self.lever_vel_e_n(mat_np)
-            lat = nav.lat - d[1] / (rm + nav.height)
-            lon = wrap_pi(nav.lon - d[0] / ((rn + nav.height) * cos_lat))
-            height = nav.height - d[2]
+            lat, lon, height, vel = self.reference_point()
             if self.sd.vertical == strapdown.VERTICAL_HOLD:
                 vel[2] = 0.0
         return {
             "tick": self.tick,
             "mode": self.mode,
             "fault_flags": self.faults,
-            "state_flags": STATE_ATT_VALID if valid else 0,
+            "state_flags": STATE_ATT_VALID if valid and not self.integrity_lost else 0,
             "lat_rad": lat,
             "lon_rad": lon,
             "height_m": height,
@@ -783,6 +882,8 @@ class Firmware:
             "align_restarts": self.align_restarts,
             **self.counts,
             "seq": self.seq,
+            "align_nis": self.fine.nis_mean if self.fine is not None else 0.0,
+            "coarse_wander_rad": self.coarse.wander if self.cfg["coarse_ticks"] > 0 else 0.0,
             "kf_x": self._kf(lambda f: f.x),
             "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
         }
@@ -791,6 +892,9 @@ class Firmware:
         out = np.zeros(8)
         if self.fine is not None:
             v = get(self.fine)
+            if len(v) == moving_align.STATES:    # [phi, eps, nabla_E, nabla_N], as the 8-state filter
+                v = v[[0, 1, 2, moving_align.EPS, moving_align.EPS + 1, moving_align.EPS + 2,
+                       moving_align.NABLA, moving_align.NABLA + 1]]
             out[:len(v)] = v
         return out
 

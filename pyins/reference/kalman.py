@@ -12,16 +12,22 @@ def predict(x, p, phi, qd):
 
 
 def update2(x, p, h, z, r):
-    """Joseph-form update with z = H x + v (2 measurements). Returns (x, P)."""
+    """Joseph-form update with z = H x + v (2 measurements).
+
+    Returns (x, P, nis) with nis = nu^T S^-1 nu the normalised innovation
+    squared (mirrors update2).
+    """
     s = h @ p @ h.T + r
     det = s[0, 0] * s[1, 1] - s[0, 1] * s[1, 0]
     s_inv = np.array([[s[1, 1] / det, -s[0, 1] / det],
                       [-s[1, 0] / det, s[0, 0] / det]])
     k = p @ h.T @ s_inv
-    x = x + k @ (z - h @ x)
+    nu = z - h @ x
+    nis = float(nu @ (s_inv @ nu))
+    x = x + k @ nu
     ikh = np.eye(len(x)) - k @ h
     pj = ikh @ p @ ikh.T + k @ r @ k.T
-    return x, 0.5 * (pj + pj.T)
+    return x, 0.5 * (pj + pj.T), nis
 
 
 def diagonal_positive(p):

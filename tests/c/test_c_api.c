@@ -96,6 +96,7 @@ int main(void) {
                              PYINS_E_SNAPSHOT_VERSION, PYINS_E_SNAPSHOT_CORRUPT,
                              PYINS_E_SAMPLE_SATURATED, PYINS_E_CONFIG_SATURATION, PYINS_E_CONFIG_SEQ,
                              PYINS_E_CONFIG_INDEX_SUMS, PYINS_E_CONFIG_LEVER, PYINS_E_CONFIG_COARSE_METHOD,
+                             PYINS_E_CONFIG_INTEGRITY,
                              PYINS_W_SEQ_GAP, PYINS_W_SEQ_REPEAT, PYINS_W_SEQ_LOST, PYINS_W_ENCODER_JUMP};
         const size_t n = sizeof codes / sizeof codes[0];
         size_t i, j;
@@ -117,6 +118,8 @@ int main(void) {
         check(PYINS_E_SNAPSHOT_CORRUPT == -30 && PYINS_E_SAMPLE_SATURATED == -31 &&
               PYINS_E_CONFIG_SATURATION == -32 && PYINS_E_CONFIG_SEQ == -33 && PYINS_E_CONFIG_INDEX_SUMS == -34 &&
               PYINS_E_CONFIG_LEVER == -35 && PYINS_E_CONFIG_COARSE_METHOD == -36 &&
+              PYINS_E_CONFIG_INTEGRITY == -37 && PYINS_FAULT_ALIGN_INCONSISTENT == 256 &&
+              PYINS_FAULT_COARSE_UNSETTLED == 512 &&
               PYINS_W_SEQ_GAP == 1 &&
               PYINS_W_SEQ_REPEAT == 2 && PYINS_W_SEQ_LOST == 3 && PYINS_W_ENCODER_JUMP == 4,
               "pinned sample-level status values");
@@ -230,6 +233,31 @@ int main(void) {
     BAD_CFG(b.coarse_method = -1, PYINS_E_CONFIG_COARSE_METHOD, "negative coarse method");
     BAD_CFG((b.coarse_method = PYINS_COARSE_FIT, b.coarse_ticks = 3000, b.coarse_first_output_ticks = 700),
             PYINS_E_CONFIG_ALIGN_EARLY, "FIT with fewer than 8 grid intervals at its first output");
+    BAD_CFG(b.fine_states = 11, PYINS_E_CONFIG_FINE, "fine_states 11");
+    BAD_CFG(b.fine_pos_sigma_m = -0.5, PYINS_E_CONFIG_NOISE, "negative wave displacement sigma");
+    BAD_CFG(b.fine_sigma0_vel_mps = NAN, PYINS_E_CONFIG_NOISE, "NaN initial velocity sigma");
+    BAD_CFG(b.integrity_nis_window = -2, PYINS_E_CONFIG_INTEGRITY, "NIS window below -1");
+    BAD_CFG(b.integrity_nis_max = -1.0, PYINS_E_CONFIG_INTEGRITY, "negative NIS bound");
+    BAD_CFG(b.integrity_nis_max = NAN, PYINS_E_CONFIG_INTEGRITY, "NaN NIS bound");
+    BAD_CFG(b.integrity_coarse_rad = INFINITY, PYINS_E_CONFIG_INTEGRITY, "Inf wander bound");
+    BAD_CFG(b.integrity_coarse_rad = -0.01, PYINS_E_CONFIG_INTEGRITY, "negative wander bound");
+    {
+        /* FIT has no length limit (its grid halves when full); TRIAD keeps it */
+        pyins_config g;
+        pyins_config_default(&g);
+        g.coarse_method = PYINS_COARSE_FIT;
+        g.coarse_ticks = 60000;
+        check_status(pyins_config_check(&g), PYINS_OK, "FIT of 600 s on 1 s outputs accepted");
+        g.coarse_method = PYINS_COARSE_TRIAD;
+        check_status(pyins_config_check(&g), PYINS_E_CONFIG_ALIGN_LONG, "TRIAD of 600 s refused");
+        pyins_config_default(&g);
+        g.integrity_nis_window = -1;
+        check_status(pyins_config_check(&g), PYINS_OK, "NIS test off accepted");
+        pyins_config_default(&g);
+        g.fine_ticks = 1000;
+        g.fine_states = 12;
+        check_status(pyins_config_check(&g), PYINS_OK, "the moving-base filter accepted");
+    }
     {
         pyins_config g;
         pyins_config_default(&g);

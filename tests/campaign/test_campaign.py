@@ -51,9 +51,10 @@ def local_run(tmp_path_factory):
 # ---------------------------------------------------------------------------
 def test_builtin_campaigns_load():
     names = [n for n, _ in campaign.list_builtin()]
-    assert names == ["seed000_static", "seed000_swing", "seed002_schemes"]
+    assert names == ["moored_heave_lever", "seed000_static", "seed000_swing", "seed002_schemes"]
     sizes = {n: len(campaign.load_campaign(n).points) for n in names}
-    assert sizes == {"seed000_static": 30, "seed000_swing": 90, "seed002_schemes": 40}
+    assert sizes == {"moored_heave_lever": 120, "seed000_static": 30, "seed000_swing": 90,
+                     "seed002_schemes": 40}
     swing = campaign.load_campaign("seed000_swing")
     assert len(swing.groups) == 18 and swing.compare == "drop"
     assert campaign.load_campaign("seed002_schemes").base.with_overrides(

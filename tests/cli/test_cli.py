@@ -74,6 +74,17 @@ MISTAKES = [
     ("malformed TOML", SHORT.replace('kind = "static"', 'kind = "static'), "line", ""),
     ("unknown preset", SHORT.replace('"seed003"', '"seed009"'), "sensors.preset", "seed009"),
     ("unknown scheme", SHORT.replace('"single_position"', '"spin"'), "indexing.scheme", "spin"),
+    ("negative heave period", SHORT.replace('heading = "30 deg"\n', 'heading = "30 deg"\n'
+     'heave = [{ amplitude = "0.5 m", period = "-8 s" }]\n'), "motion.heave[0].period", "range"),
+    ("lever arm too long", SHORT.replace('heading = "30 deg"\n', 'heading = "30 deg"\n'
+     'lever_b = ["80 m", "80 m", "0 m"]\n'), "motion.lever_b", "100 m"),
+    ("spectrum and heave", SHORT.replace('heading = "30 deg"\n', 'heading = "30 deg"\n'
+     'heave = [{ amplitude = "0.5 m", period = "8 s" }]\nspectrum = { hs = "1 m", tp = "8 s" }\n'),
+     "motion.spectrum", "not both"),
+    ("spectrum hs 0", SHORT.replace('heading = "30 deg"\n', 'heading = "30 deg"\n'
+     'spectrum = { hs = "0 m", tp = "8 s" }\n'), "motion.spectrum.hs", "range"),
+    ("unknown lever", SHORT.replace('[indexing]', '[firmware]\nlever = "guessed"\n[indexing]'),
+     "firmware.lever", "guessed"),
 ]
 
 

@@ -36,12 +36,13 @@ def scenarios(draw):
     # wrong, but not to 1e-10). So: waves with FIT, then navigation; or
     # navigation from the configured state.
     method = draw(st.sampled_from([0, 1]))
-    waves = (kind == "coarse" and method == 1) or kind == "nav"
+    states = draw(st.sampled_from([5, 8, 12]))
+    waves = (kind == "coarse" and method == 1) or kind == "nav" or (kind == "fine" and states == 12)
     wave = draw(st.floats(0.0, 1.0)) if waves else 0.0
     m = sim.ShipAtSea(base, sim.LinearMotion(heave=[(wave, 8.0, 0.3)], surge=[(0.3 * wave, 12.0, 1.0)],
                                              sway=[(0.3 * wave, 10.0, 2.0)]),
                       lever_b=lever_b, lever_p=lever_p)
-    cfg = dict(fine_states=draw(st.sampled_from([5, 8])),
+    cfg = dict(fine_states=states,
                coarse_method=method, vertical_mode=draw(st.sampled_from([0, 1])))
     if kind == "coarse":
         cfg.update(coarse_ticks=3000, coarse_first_output_ticks=2000, fine_ticks=0 if waves else 1000)
@@ -93,12 +94,20 @@ def _run_both(m, cfg, n, table=None):
 def test_ten_minutes_of_moving_base_alignment_cpp_equals_reference():
     # The moored ship of the built-in scenarios: seed 000's general swing,
     # heave 0.5 m / surge 0.3 m / sway 0.3 m at 8-12 s, lever arm (0.5, 1.5,
-    # 1.2) m; FIT coarse alignment for 300 s, then 300 s of navigation.
+    # 1.2) m; FIT coarse alignment for 120 s, then 480 s of the moving-base
+    # fine alignment (12 states), then 60 s of navigation.
     m = sim.moored("general", 34.246 * DEG, 108.91 * DEG, 380.0, 0.7)
-    cfg = runner.initial_config(m, None, coarse_ticks=30000, coarse_method=1,
-                                coarse_output_every_ticks=200)   # 300 s on a 2 s grid
-    out = _run_both(m, cfg, 60000)
-    assert out[-1]["mode"] == 3
+    cfg = runner.initial_config(m, None, coarse_ticks=12000, coarse_method=1, fine_ticks=48000,
+                                fine_states=12)
+    out = _run_both(m, cfg, 66000)
+    assert out[-1]["mode"] == 3 and out[-1]["kf_states"] == 12
+
+
+def test_fit_beyond_its_grid_cpp_equals_reference():
+    # FIT halves its grid when full: 400 s on 1 s outputs crosses 255 intervals
+    m = sim.moored("bad", 34.246 * DEG, 108.91 * DEG, 380.0, 2.0)
+    cfg = runner.initial_config(m, None, coarse_ticks=40000, coarse_method=1)
+    _run_both(m, cfg, 40100)
 
 
 def test_fine_alignment_with_lever_arm_cpp_equals_reference():

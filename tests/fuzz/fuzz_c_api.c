@@ -203,13 +203,16 @@ static const field kFields[] = {
     FLD(index_delta, T_F64), FLD(index_max_flex_rad, T_F64), FLD(index_tolerance_rad, T_F64),
     FLD(index_jump_rad, T_F64), FLD(seq_mode, T_I32), FLD(seq_max_gap_ticks, T_I32),
     FLD(sat_gyro_rad, T_F64), FLD(sat_accel_mps, T_F64), FLD(index_sums, T_I32), FLD(reserved1, T_I32),
+    FLD(lever_b_m, T_F64), FLD(lever_p_m, T_F64), FLD(coarse_method, T_I32), FLD(reserved2, T_I32),
+    FLD(integrity_nis_window, T_I32), FLD(reserved3, T_I32), FLD(integrity_nis_max, T_F64),
+    FLD(integrity_coarse_rad, T_F64), FLD(fine_pos_sigma_m, T_F64), FLD(fine_sigma0_vel_mps, T_F64),
 };
 #undef FLD
 #define N_FIELDS ((int)(sizeof kFields / sizeof kFields[0]))
 /* Array fields (vel, euler, sigma0_att: 3 doubles; index_steps: 8 x 3). */
 #define N_PATCH_TARGETS (N_FIELDS + 6 + 24)
 
-#define N_PRESETS 7
+#define N_PRESETS 8
 
 /* Valid, short configurations that reach every mode and indexing scheme
  * within the tick budget. */
@@ -285,6 +288,22 @@ static void preset(int k, pyins_config *c) {
             c->index_sums = PYINS_INDEX_SUMS_ALL;
             c->index_stop_ticks = 20;
             c->index_delta = 0.5;
+            break;
+        case 7: /* a moored ship: lever arms, FIT coarse, the moving-base fine filter */
+            c->lever_b_m[0] = 0.5;
+            c->lever_b_m[1] = 1.5;
+            c->lever_b_m[2] = 1.2;
+            c->lever_p_m[0] = 0.05;
+            c->coarse_ticks = 300;
+            c->coarse_first_output_ticks = 200;
+            c->coarse_output_every_ticks = 25;
+            c->coarse_method = PYINS_COARSE_FIT;
+            c->fine_ticks = 300;
+            c->fine_states = 12;
+            c->fine_meas_every_ticks = 20;
+            c->integrity_nis_window = 3;
+            c->index_scheme = PYINS_INDEX_TWO_POSITION;
+            c->index_stop_ticks = 40;
             break;
         default: /* four-position, fast moves */
             c->index_scheme = PYINS_INDEX_FOUR_POSITION;
@@ -450,7 +469,10 @@ static int g_garbage = 0;
 static void check_output(const pyins_output *o) {
     if (g_garbage) return;
     REQUIRE(o->mode >= PYINS_MODE_IDLE && o->mode <= PYINS_MODE_NAVIGATE, "output mode");
-    REQUIRE(o->kf_states == 0 || o->kf_states == 5 || o->kf_states == 8, "output kf_states");
+    REQUIRE(o->kf_states == 0 || o->kf_states == 5 || o->kf_states == 8 || o->kf_states == 12,
+            "output kf_states");
+    REQUIRE(!(o->coarse_wander_rad < 0.0) && !(o->coarse_wander_rad > 1.0 + 1e-12), "coarse_wander_rad in [0, 1]");
+    REQUIRE(!(o->align_nis < 0.0), "align_nis >= 0");
     REQUIRE(o->index_state >= PYINS_INDEX_IDLE && o->index_state <= PYINS_INDEX_FAULT, "output index_state");
     REQUIRE(o->index_fault >= 0 && o->index_fault <= 3, "output index_fault");
     REQUIRE(o->index_step >= 0 && o->index_step < 8, "output index_step");

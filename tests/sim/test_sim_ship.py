@@ -293,7 +293,9 @@ def test_lever_p_uses_the_table_and_node_rates_refuse_it():
 
 # --- end to end through the C++ firmware ---------------------------------------
 def _errors_at_imu(motion, table=None, config=None):
-    cfg = dict(vertical_mode="free", coarse_ticks=0)
+    # the firmware is not told the lever arm: it navigates the IMU point
+    cfg = dict(vertical_mode="free", coarse_ticks=0, lever_b_m=[0.0, 0.0, 0.0],
+               lever_p_m=[0.0, 0.0, 0.0])
     if isinstance(motion, S.ShipAtSea):    # the true IMU-point state at t = 0
         st0 = motion.state(np.array([0.0]), table=table)
         cfg.update(lat_rad=st0.lat[0], lon_rad=st0.lon[0], height_m=st0.height[0],

@@ -1,0 +1,102 @@
+// moving_align.hpp: moving-base Kalman fine alignment of a moored ship by
+// position matching, 12 states, for the IMU frame p.
+//
+// Mirrored by pyins/reference/moving_align.py.
+//
+// Why: seed 001's static filters measure the specific force in n; on a
+// heaving ship that carries the waves' acceleration (0.01-0.1 m/s^2 against
+// the ug the level needs) and they fail (their NIS test flags it). Here the
+// strapdown runs free in the horizontal (the vertical channel held) and the
+// measurement is the reference point's position relative to the mooring
+// site: the waves enter as a displacement of tenths of a metre with zero
+// mean, which the filter takes as measurement noise; tilt and heading act
+// through the velocity and position errors they make grow (the velocity-
+// matching idea of PSINS's alignvn, in position, which the waves disturb
+// less: a wave's displacement is its acceleration / w^2, ~0.5 m at 8 s for
+// 0.3 m/s^2).
+//
+// States (phi as in fine_align: C_p^n' = (I - phi x) C_p^n; errors =
+// computed - true; eps, nabla in n, random constants):
+//   X = [phi_E phi_N phi_U dv_E dv_N dp_E dp_N eps_E eps_N eps_U nabla_E nabla_N]
+// Dynamics, linearised about the ship at rest (Qin Yongyuan, "Inertial
+// Navigation", 2nd ed. 2014, eqs. 4.2.6 and 4.2.15, ENU, vertical held):
+//   phi'  = phi x w_ie^n + [-dv_N / R_M, dv_E / R_N, dv_E tanL / R_N] - eps
+//   dv_E' = f_N phi_U - f_U phi_N + 2 w_U dv_N + nabla_E      (f x phi + nabla)
+//   dv_N' = f_U phi_E - f_E phi_U - 2 w_U dv_E + nabla_N
+//   dp'   = dv
+// with f^n the mean specific force over the interval. The static part
+// (phi x w_ie - eps) is seed 001's eq. 10.
+// Measurement every meas_every ticks: z = [E, N] offset of the reference
+// point from the site [m] = dp + d_wave + v, R = pos_sigma^2 I.
+// Discretisation once per interval T: Phi = I + F T + (F T)^2 / 2, Qd =
+// diag(arw^2 T on phi, vrw^2 T on dv); the update as two scalar updates
+// (H a unit row, R diagonal). Feedback after every update (the
+// firmware corrects attitude, velocity and position and zeroes phi, dv, dp).
+// Integrity: the same NIS windows as fine_align.
+#pragma once
+
+#include <cstdint>
+
+#include "kalman.hpp"
+#include "types.hpp"
+
+namespace pyins::moving_align {
+
+inline constexpr int kStates = 12;
+/// State indices.
+inline constexpr int kPhi = 0;    ///< phi_E, phi_N, phi_U
+inline constexpr int kVel = 3;    ///< dv_E, dv_N
+inline constexpr int kPos = 5;    ///< dp_E, dp_N
+inline constexpr int kEps = 7;    ///< eps_E, eps_N, eps_U
+inline constexpr int kNabla = 10; ///< nabla_E, nabla_N
+
+struct Params {
+    double sin_lat;
+    double cos_lat;
+    double rm_h;             ///< R_M + h at the site [m]
+    double rn_h;             ///< R_N + h at the site [m]
+    double dt;               ///< tick [s]
+    int32_t meas_every;      ///< ticks per update
+    double gyro_arw;         ///< [rad/sqrt(s)]
+    double accel_vrw;        ///< [(m/s)/sqrt(s)]
+    double pos_sigma;        ///< R: the waves' horizontal displacement [m]
+    double sigma0_att[3];    ///< [rad]
+    double sigma0_vel;       ///< [m/s]
+    double sigma0_gyro;      ///< [rad/s]
+    double sigma0_accel;     ///< [m/s^2]
+    int32_t nis_window;      ///< updates per NIS window; 0: no test
+    double nis_max;
+};
+
+struct MovingAlign {
+    Params prm;
+    kalman::Vec<kStates> x;
+    kalman::Mat<kStates, kStates> p;
+    Vec3 dv_sum;             ///< specific-force velocity increments in n' since the last update
+    int32_t meas_count;
+    bool healthy;
+    bool consistent;
+    double nis_sum;
+    int32_t nis_count;
+    double nis_mean;
+    int32_t nis_windows;
+};
+
+void init(MovingAlign& m, const Params& prm);
+
+/// Continuous-time F for the mean specific force f_n [m/s^2].
+kalman::Mat<kStates, kStates> system_matrix(const Params& prm, const Vec3& f_n);
+
+/// One tick: gather the specific force; at the end of an interval predict
+/// over it and update with z_en, the reference point's [E, N] offset from
+/// the site [m] (read only then; `measure` says whether it is due).
+/// Returns true when an update happened.
+bool step(MovingAlign& m, const Vec3& dv_sf_n, const double z_en[2]);
+
+/// True when this tick ends an interval (the firmware forms z then).
+inline bool measure(const MovingAlign& m) { return m.meas_count + 1 == m.prm.meas_every; }
+
+/// After the feedback: phi, dv, dp = 0.
+void reset_feedback(MovingAlign& m);
+
+}  // namespace pyins::moving_align
