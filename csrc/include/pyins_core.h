@@ -181,7 +181,9 @@ enum pyins_state_flag {
     PYINS_STATE_ATT_VALID = 1     /* the attitude is a solution, not the configured guess nor a
                                      provisional one (coarse solutions until the coarse alignment
                                      has ended and passed its wander test; a fine estimate before
-                                     the first NIS window has passed), and no
+                                     the first NIS window has passed or while the filter's heading
+                                     sigma exceeds 10'; a fine alignment that ended with a larger
+                                     one), and no
                                      integrity test failed (PYINS_FAULT_ALIGN_INCONSISTENT,
                                      PYINS_FAULT_COARSE_UNSETTLED: once set, never valid again) */
 };

@@ -649,8 +649,19 @@ void Firmware::apply_fine_correction() {
     }
 }
 
+bool Firmware::fine_heading_known() const {
+    const double var = kf_states_ == 12 ? moving_.p(2, 2)
+                       : (kf_states_ == 8 ? fine8_.p(2, 2) : fine5_.p(2, 2));
+    return var <= kValidHeadingSigma * kValidHeadingSigma;
+}
+
 void Firmware::end_fine() {
-    // Navigation starts from the corrected attitude (both correction modes).
+    // Navigation starts from the corrected attitude (both correction modes);
+    // a heading the filter does not know to kValidHeadingSigma is not valid
+    // there either.
+    if (!fine_heading_known()) {
+        att_valid_ = false;
+    }
     apply_fine_correction();
     if (has_lever_ != 0 && kf_states_ != 12) {
         place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
@@ -989,7 +1000,7 @@ void Firmware::output(pyins_output* out) const {
             attitude::quat_mul(attitude::rotvec_to_quat(fine_phi()), nav.quat_np));
         const int32_t windows = kf_states_ == 12 ? moving_.nis_windows
                                 : (kf_states_ == 8 ? fine8_.nis_windows : fine5_.nis_windows);
-        if (cfg_.integrity_nis_window > 0 && windows == 0) {
+        if ((cfg_.integrity_nis_window > 0 && windows == 0) || !fine_heading_known()) {
             valid = false;
         }
     }

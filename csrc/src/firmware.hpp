@@ -81,6 +81,11 @@ inline constexpr double kMaxLeverM = 100.0;
 /// fifth (measured on the moored ship with seed 000's errors: FIT over 120 s
 /// wanders 2.7-10.9', over 300 s < 1.5'; TRIAD over 300 s 164-326').
 inline constexpr int32_t kDefaultNisWindow = 100;
+/// A fine-alignment attitude is valid only once the filter's own heading
+/// sigma is within 10' (the bound the integrity acceptance uses): on PSINS's
+/// real laser-gyro log seed 001's 600' prior let the static filter wander
+/// 45' from its final heading while its sigma was still 440' (measured).
+inline constexpr double kValidHeadingSigma = 10.0 * kArcminRad;
 inline constexpr double kDefaultNisMax = 4.0;
 inline constexpr double kDefaultCoarseWander = 30.0 * kArcminRad;
 /// "PYNS": marks memory that holds an initialised instance.
@@ -157,6 +162,8 @@ class Firmware {
     void reject(uint32_t fault_bit, uint32_t* counter);
     /// Leave coarse alignment for fine alignment or navigation.
     void end_coarse();
+    /// The fine filter's heading sigma is within kValidHeadingSigma.
+    bool fine_heading_known() const;
     /// Start / leave fine alignment.
     void start_fine();
     void end_fine();

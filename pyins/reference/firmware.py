@@ -100,6 +100,7 @@ DEFAULT_FINE_VRW = 10.0e-6 * 9.80665                        #: kDefaultFineVrw
 ARCMIN_RAD = np.pi / 180.0 / 60.0                           #: kArcminRad
 DEFAULT_FINE_SIGMA_ATT = (100.0 * ARCMIN_RAD, 100.0 * ARCMIN_RAD, 600.0 * ARCMIN_RAD)
 DEFAULT_COARSE_WANDER = 30.0 * ARCMIN_RAD                   #: kDefaultCoarseWander
+VALID_HEADING_SIGMA = 10.0 * ARCMIN_RAD                     #: kValidHeadingSigma
 DEFAULT_FINE_SIGMA_GYRO = 0.01 * (np.pi / 180.0) / 3600.0   #: kDefaultFineSigmaGyro
 DEFAULT_FINE_SIGMA_ACCEL = 100.0e-6 * 9.80665               #: kDefaultFineSigmaAccel
 DEG = np.pi / 180.0                                         #: kDeg
@@ -532,7 +533,13 @@ class Firmware:
         else:
             fine_align.reset_phi(self.fine)
 
+    def fine_heading_known(self):
+        """The fine filter's heading sigma is within VALID_HEADING_SIGMA (mirrors fine_heading_known)."""
+        return self.fine.p[2, 2] <= VALID_HEADING_SIGMA * VALID_HEADING_SIGMA
+
     def end_fine(self):
+        if not self.fine_heading_known():
+            self.att_valid = False
         self.apply_fine_correction()
         if self.has_lever and self.kf_states != 12:
             self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
@@ -846,8 +853,9 @@ class Firmware:
         elif self.mode == MODE_FINE_ALIGN:
             q_np = attitude.quat_normalize(
                 attitude.quat_mul(attitude.rotvec_to_quat(self.fine_phi()), nav.quat_np))
-            if self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0:
-                valid = False   # provisional until the first NIS window has passed
+            if ((self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0)
+                    or not self.fine_heading_known()):
+                valid = False   # provisional until the first NIS window, and the heading known
         q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
         euler_b = attitude.quat_to_euler(q_nb)
         lat, lon, height, vel = nav.lat, nav.lon, nav.height, nav.vel_n.copy()
