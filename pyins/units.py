@@ -2,10 +2,10 @@
 
 ``parse_quantity("0.003 deg/h", "angular_rate")`` returns the value in SI
 (rad/s). Every dimension has a fixed list of accepted units (`UNITS`); the
-conversion factors are the named constants of `pyins.reference.earth`
+conversion factors are the named constants defined below
 (DEG_TO_RAD, ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, G0, UG_TO_MPS2,
 NMI_TO_M), so ``parse_quantity("30 ug", "acceleration")`` is bit for bit
-``30.0 * earth.UG_TO_MPS2``, the number the sensor presets hold.
+``30.0 * UG_TO_MPS2``, the number the sensor presets hold.
 
 Plain numbers (no unit)
 -----------------------
@@ -33,7 +33,24 @@ not ``Mg``) except that ``hz`` is read as ``Hz``.
 import math
 import re
 
-from pyins.reference import earth
+import numpy as np
+
+# --- the constants, each defined once (csrc/src/units.hpp: kPi, kDegToRad, ...) --
+# Everything in pyins that converts a unit or counts a tick reads these.
+TWO_PI = 2.0 * np.pi                       #: (kTwoPi)
+DEG_TO_RAD = np.pi / 180.0                 #: (kDegToRad)
+ARCSEC_TO_RAD = DEG_TO_RAD / 3600.0        #: (kArcsecToRad)
+ARCMIN_TO_RAD = DEG_TO_RAD / 60.0          #: (kArcminToRad)
+DPH_TO_RPS = DEG_TO_RAD / 3600.0           #: deg/h -> rad/s (kDphToRps)
+G0 = 9.80665                               #: standard gravity for ug/mg units [m/s^2] (kG0)
+UG_TO_MPS2 = 1e-6 * G0                     #: micro-g -> m/s^2 (kUgToMps2)
+NMI_TO_M = 1852.0                          #: nautical mile [m] (kNmiToM)
+
+#: The firmware's default tick rate [Hz] (kDefaultTickHz) and its tick [s].
+#: A scenario runs at this rate; logs may run at others (the firmware's
+#: ``tick_hz``), so code that handles logs takes ``dt`` from the data.
+TICK_HZ = 100
+DT = 1.0 / TICK_HZ
 
 
 class ScenarioError(ValueError):
@@ -59,30 +76,30 @@ class ScenarioError(ValueError):
         return ScenarioError(self.reason, self.key, self.source or source)
 
 
-_DEG = earth.DEG_TO_RAD
-_G0 = earth.G0
+_DEG = DEG_TO_RAD
+_G0 = G0
 
 #: dimension -> {unit: factor to SI}. The SI unit of each dimension is the
 #: one with factor 1 listed first.
 UNITS = {
     "angle": {"rad": 1.0, "mrad": 1e-3, "urad": 1e-6, "deg": _DEG,
-              "arcmin": earth.ARCMIN_TO_RAD, "'": earth.ARCMIN_TO_RAD,
-              "arcsec": earth.ARCSEC_TO_RAD, '"': earth.ARCSEC_TO_RAD},
+              "arcmin": ARCMIN_TO_RAD, "'": ARCMIN_TO_RAD,
+              "arcsec": ARCSEC_TO_RAD, '"': ARCSEC_TO_RAD},
     "angular_rate": {"rad/s": 1.0, "mrad/s": 1e-3, "deg/s": _DEG, "deg/min": _DEG / 60.0,
-                     "deg/h": earth.DPH_TO_RPS, "arcsec/s": earth.ARCSEC_TO_RAD},
+                     "deg/h": DPH_TO_RPS, "arcsec/s": ARCSEC_TO_RAD},
     "angular_acceleration": {"rad/s^2": 1.0, "deg/s^2": _DEG},
     # 1 deg/sqrt(h) = DEG / sqrt(3600 s) = DEG / 60 rad/sqrt(s) (as pyins.sim.sensors);
     # a rate density [rad/s/sqrt(Hz)] is numerically the same as rad/sqrt(s).
     "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": _DEG / 60.0,
-                          "rad/s/sqrt(Hz)": 1.0, "deg/h/sqrt(Hz)": earth.DPH_TO_RPS},
-    "acceleration": {"m/s^2": 1.0, "g": _G0, "mg": 1e-3 * _G0, "ug": earth.UG_TO_MPS2},
+                          "rad/s/sqrt(Hz)": 1.0, "deg/h/sqrt(Hz)": DPH_TO_RPS},
+    "acceleration": {"m/s^2": 1.0, "g": _G0, "mg": 1e-3 * _G0, "ug": UG_TO_MPS2},
     # 1 ug/sqrt(Hz) = UG_TO_MPS2 (m/s^2)/sqrt(Hz), numerically the same in (m/s)/sqrt(s).
     "velocity_random_walk": {"m/s/sqrt(s)": 1.0, "m/s/sqrt(h)": 1.0 / 60.0,
-                             "m/s^2/sqrt(Hz)": 1.0, "ug/sqrt(Hz)": earth.UG_TO_MPS2,
+                             "m/s^2/sqrt(Hz)": 1.0, "ug/sqrt(Hz)": UG_TO_MPS2,
                              "mg/sqrt(Hz)": 1e-3 * _G0},
-    "velocity": {"m/s": 1.0, "km/h": 1.0 / 3.6, "knot": earth.NMI_TO_M / 3600.0,
-                 "kn": earth.NMI_TO_M / 3600.0},
-    "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3, "nmi": earth.NMI_TO_M},
+    "velocity": {"m/s": 1.0, "km/h": 1.0 / 3.6, "knot": NMI_TO_M / 3600.0,
+                 "kn": NMI_TO_M / 3600.0},
+    "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3, "nmi": NMI_TO_M},
     "time": {"s": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "d": 86400.0},
     "frequency": {"Hz": 1.0, "mHz": 1e-3},
     "dimensionless": {"": 1.0, "ppm": 1e-6, "ppb": 1e-9, "%": 1e-2},

@@ -30,14 +30,9 @@ GAMMA_E = 9.7803253359             #: normal gravity at the equator [m/s^2] (kGa
 K_SOMIGLIANA = 0.00193185265241    #: Somigliana constant k [-] (kSomigliana)
 M_GRAV = OMEGA_IE * OMEGA_IE * A * A * B / GM  #: m = w^2 a^2 b / GM [-] (kMGrav)
 
-# --- named unit conversions (earth.hpp: kDegToRad, ...) ---------------------
-DEG_TO_RAD = np.pi / 180.0                 #: (kDegToRad)
-ARCSEC_TO_RAD = DEG_TO_RAD / 3600.0        #: (kArcsecToRad)
-ARCMIN_TO_RAD = DEG_TO_RAD / 60.0          #: (kArcminToRad)
-DPH_TO_RPS = DEG_TO_RAD / 3600.0           #: deg/h -> rad/s (kDphToRps)
-G0 = 9.80665                               #: standard gravity for ug/mg units [m/s^2] (kG0)
-UG_TO_MPS2 = 1e-6 * G0                     #: micro-g -> m/s^2 (kUgToMps2)
-NMI_TO_M = 1852.0                          #: nautical mile [m] (kNmiToM)
+# --- named unit conversions: defined once, in pyins.units (units.hpp) -----
+from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS, G0,  # noqa: E402,F401
+                         NMI_TO_M, UG_TO_MPS2)
 
 
 def principal_radii(sin_lat):

@@ -16,7 +16,7 @@ D = earth.DEG_TO_RAD
 ARCSEC = earth.ARCSEC_TO_RAD
 DT = 0.01
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
-XIAN = (34.246 * D, 108.910 * D)      # seed 002's site, as tests/scenarios/test_error_free_nav.py
+XIAN = (34.246 * D, 108.910 * D)      # seed 002's site, as tests/physics/test_error_free_nav.py
 
 
 def central_diff(fun, t, h):
