@@ -1,12 +1,18 @@
-"""The plant: ship and turntable motion, exact IMU increments, sensor errors, files.
+"""The simulator: ship and turntable motion, exact IMU increments, sensor
+errors, files. One room per concept:
 
-- `pyins.sim.motion`: analytic motion profiles (`Static`, `Swing` and the
-  seed 000 sea states, `HeadingSwing` of seed 002, `Manoeuvre`) and turntable
-  profiles (`Fixed`, `ConstantRate`).
-- `pyins.sim.ship`: a real ship at the pier: heave, surge and sway
-  (`LinearMotion`), lever arms (`ShipAtSea`), wave spectra
+- `pyins.sim.exact_time`: times as exact (hi, lo) pairs and phases reduced
+  without losing bits (`split_times`, `frac_cycles`), what keeps a 72-h run
+  exact.
+- `pyins.sim.motion`: the ship's base motions (`Static`, `Swing` and the
+  seed 000 sea states, `HeadingSwing` of seed 002, `Manoeuvre`).
+- `pyins.sim.ship`: the sea around a real ship at the pier: heave, surge and
+  sway (`LinearMotion`), lever arms (`ShipAtSea`), wave spectra
   (`sea_spectrum_motion`, `SEA_STATE_SPECTRA`) and the built-in moored ship
   (`moored`, `MOORED_SHIP`).
+- `pyins.sim.turntable`: the table's profiles (`TableMotion`, `Fixed`,
+  `ConstantRate`) and the NumPy mirror of the compiled firmware-in-the-loop
+  plant (csrc/plant/plant.cpp).
 - `pyins.sim.imu`: exact per-tick increments by Gauss-Legendre quadrature of
   the body rate and specific force (`exact_increments`), the true state at the
   sample instants (`truth`), and a chunked run generator (`generate`).
@@ -14,31 +20,33 @@
   quantisation (`SensorErrors`, `SensorModel`, `preset`).
 - `pyins.sim.io`: .npz and CSV sample files.
 
-Frames and units as in ``pyins`` (DESIGN.md section 2): n = ENU, b = x
+Frames and units as in ``pyins`` (docs/design.md §2): n = ENU, b = x
 starboard / y bow / z up, p = IMU on the turntable with C_p^b = Rz(alpha);
-Euler [pitch, roll, yaw], C_b^n = Rz(yaw) Rx(pitch) Ry(roll); SI inside. The
-Earth model is ``pyins.reference.earth``, the same as the firmware's.
+Euler [pitch, roll, yaw], C_b^n = Rz(yaw) Rx(pitch) Ry(roll); SI inside;
+the tick and the unit constants are `pyins.units`'. The Earth model is
+``pyins.reference.earth``, the same as the firmware's.
 """
 from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, euler_to_quat,
-                           exact_increments, generate, node_rates, truth, truth_at)
+                           exact_increments, generate, nb_rate_and_derivative, node_rates, truth,
+                           truth_at)
 from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
                           save_npz)
-from pyins.sim.motion import (SEA_STATES, ConstantRate, Fixed, HeadingSwing, Manoeuvre, Motion,
-                              MotionState, Segment, Static, Swing, TableMotion, default_segments,
-                              sea_state)
+from pyins.sim.motion import (SEA_STATES, HeadingSwing, Manoeuvre, Motion, MotionState, Segment,
+                              Static, Swing, default_segments, sea_state)
 from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
 from pyins.sim.ship import (MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, dnv_gamma,
                             heave_response, jonswap, moored, named_sea_spectrum,
-                            nb_rate_and_derivative, pierson_moskowitz, sea_spectrum_motion)
+                            pierson_moskowitz, sea_spectrum_motion)
+from pyins.sim.turntable import ConstantRate, Fixed, TableMotion
 
 __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
-    "exact_increments", "generate", "node_rates", "truth", "truth_at",
+    "exact_increments", "generate", "nb_rate_and_derivative", "node_rates", "truth", "truth_at",
     "CSV_COLUMNS", "CSV_HEADER", "ImuData", "load_csv", "load_npz", "save_csv", "save_npz",
-    "SEA_STATES", "ConstantRate", "Fixed", "HeadingSwing", "Manoeuvre", "Motion",
-    "MotionState", "Segment", "Static", "Swing", "TableMotion", "default_segments", "sea_state",
+    "SEA_STATES", "HeadingSwing", "Manoeuvre", "Motion", "MotionState", "Segment", "Static",
+    "Swing", "default_segments", "sea_state",
     "PRESETS", "SensorErrors", "SensorModel", "preset",
     "MOORED_SHIP", "SEA_STATE_SPECTRA", "LinearMotion", "ShipAtSea", "dnv_gamma", "heave_response",
-    "jonswap", "moored", "named_sea_spectrum", "nb_rate_and_derivative", "pierson_moskowitz",
-    "sea_spectrum_motion",
+    "jonswap", "moored", "named_sea_spectrum", "pierson_moskowitz", "sea_spectrum_motion",
+    "ConstantRate", "Fixed", "TableMotion",
 ]

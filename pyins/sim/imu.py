@@ -12,7 +12,7 @@ corrections account for that). The integrals are Gauss-Legendre quadratures
 agree with 8 nodes to ~3e-18 rad and ~1e-16 m/s (rounding level) on the bad
 sea state and the manoeuvre (tested), far below the 1e-10 rad per tick that
 would already look like a 0.002 deg/h gyro drift. Node times are exact
-(hi, lo) pairs (`pyins.sim.motion.split_times`), so this holds 24 h or 72 h
+(hi, lo) pairs (`pyins.sim.exact_time.split_times`), so this holds 24 h or 72 h
 into a run as well.
 
 Kinematics (Qin 2014, sec. 4.1 and eqs. 4.1.9-4.1.11 for ENU; sec. 9.1 for
@@ -41,9 +41,17 @@ same formulas give the increments at the sensor; `truth` reports the motion
 reference point beside it (``imu_*`` fields).
 
 Ticks and samples: tick interval k (0-based) ends at t0 + (k + 1) dt; its
-sample carries the tick number k + 1 (DESIGN.md section 3: the increment over
+sample carries the tick number k + 1 (docs/design.md §3: the increment over
 [t_{k-1}, t_k] and the encoder angle at t_k). `truth` is the state at the
 same instant, so after n samples the firmware should reach ``truth`` row n-1.
+
+1. Attitude and angle helpers: `euler_to_mat`, `euler_to_quat`,
+   `wrap_two_pi_mod`, `wrap_pi_mod`.
+2. Body rate and specific force: `nb_rate_and_derivative`,
+   `body_rate_and_force`.
+3. Increments: `node_rates` (for the compiled plant), `exact_increments`.
+4. Truth: `Truth`, `truth`, `truth_at`.
+5. Chunked generation: `Chunk`, `generate`.
 """
 from dataclasses import dataclass
 
@@ -51,16 +59,17 @@ import numpy as np
 from numpy.polynomial.legendre import leggauss
 
 from pyins.reference import earth
-from pyins.sim.motion import Fixed, Static, split_times
-
-TWO_PI = 2.0 * np.pi
+from pyins.sim.exact_time import split_times
+from pyins.sim.motion import Static
+from pyins.sim.turntable import Fixed
+from pyins.units import DT, TWO_PI
 
 #: Ticks evaluated per internal block (memory bound; results do not depend on it).
 BLOCK_TICKS = 20000
 
 
 # ---------------------------------------------------------------------------
-# Vectorised attitude helpers
+# 1. Attitude and angle helpers, vectorised
 # ---------------------------------------------------------------------------
 def euler_to_mat(euler):
     """C_b^n = Rz(yaw) Rx(pitch) Ry(roll) for an (N, 3) array -> (N, 3, 3).
@@ -110,21 +119,61 @@ def euler_to_quat(euler):
     return q / norm[..., None]
 
 
-def wrap_two_pi(angle):
-    """Angle wrapped to [0, 2 pi)."""
+def wrap_two_pi_mod(angle):
+    """Angle wrapped to [0, 2 pi) by ``np.mod``, vectorised (the true table angle).
+
+    ``np.mod`` takes the exact floating remainder, so this can differ in the
+    last bits from `pyins.sim.turntable.wrap_two_pi`, the plant's
+    ``a - 2 pi floor(a / 2 pi)``.
+    """
     a = np.mod(angle, TWO_PI)
     return np.where(a >= TWO_PI, 0.0, a)
 
 
-def wrap_pi(angle):
-    """Angle wrapped to (-pi, pi]."""
+def wrap_pi_mod(angle):
+    """Angle wrapped to (-pi, pi] by ``np.mod``, vectorised, for any finite
+    angle (the true yaw; the firmware's wrap_pi takes one turn off or on)."""
     a = np.mod(angle + np.pi, TWO_PI) - np.pi
     return np.where(a <= -np.pi, a + TWO_PI, a)
 
 
 # ---------------------------------------------------------------------------
-# Body rate and specific force
+# 2. Body rate and specific force
 # ---------------------------------------------------------------------------
+def _nb_rate(sp, cp, sr, cr, dpitch, droll, dyaw):
+    """omega_nb^b = Ry^T (Rx^T [0, 0, yaw_dot] + [pitch_dot, 0, 0]) + [0, roll_dot, 0]
+    from the sines and cosines of pitch and roll: ``((x, y, z), u1, u2)`` with
+    u1 = sin(pitch) yaw_dot, u2 = cos(pitch) yaw_dot (Qin 2014 sec. 9.1)."""
+    u1 = sp * dyaw
+    u2 = cp * dyaw
+    return (cr * dpitch - sr * u2, droll + u1, sr * dpitch + cr * u2), u1, u2
+
+
+def nb_rate_and_derivative(euler, euler_rate, euler_accel):
+    """omega_nb^b and its time derivative [rad/s, rad/s^2], (N, 3) each.
+
+    omega_nb^b as in `body_rate_and_force`, differentiated term by term
+    (what the lever arms of `pyins.sim.ship.ShipAtSea` need).
+    """
+    p, r = euler[:, 0], euler[:, 1]
+    dp, dr, dy = euler_rate[:, 0], euler_rate[:, 1], euler_rate[:, 2]
+    ddp, ddr, ddy = euler_accel[:, 0], euler_accel[:, 1], euler_accel[:, 2]
+    sp, cp = np.sin(p), np.cos(p)
+    sr, cr = np.sin(r), np.cos(r)
+    (w0, w1, w2), u1, u2 = _nb_rate(sp, cp, sr, cr, dp, dr, dy)
+    du1 = cp * dp * dy + sp * ddy
+    du2 = -sp * dp * dy + cp * ddy
+    w = np.empty(euler.shape)
+    w[:, 0] = w0
+    w[:, 1] = w1
+    w[:, 2] = w2
+    wd = np.empty(euler.shape)
+    wd[:, 0] = (cr * ddp - sr * dr * dp) - (cr * dr * u2 + sr * du2)
+    wd[:, 1] = ddr + du1
+    wd[:, 2] = (sr * ddp + cr * dr * dp) + (cr * du2 - sr * dr * u2)
+    return w, wd
+
+
 def body_rate_and_force(st):
     """omega_ib^b and f^b [rad/s, m/s^2], (N, 3) each, from a MotionState.
 
@@ -147,12 +196,7 @@ def body_rate_and_force(st):
     c21 = sp
     c22 = cp * cr
 
-    # omega_nb^b = Ry^T (Rx^T [0, 0, yaw_dot] + [pitch_dot, 0, 0]) + [0, roll_dot, 0]
-    u1 = sp * dyaw
-    u2 = cp * dyaw
-    wnb_x = cr * dpitch - sr * u2
-    wnb_y = droll + u1
-    wnb_z = sr * dpitch + cr * u2
+    (wnb_x, wnb_y, wnb_z), _, _ = _nb_rate(sp, cp, sr, cr, dpitch, droll, dyaw)
 
     # Earth quantities (earth.earth_at, element-wise).
     sin_lat = np.sin(st.lat)
@@ -206,7 +250,7 @@ def _to_p(omega_b, force_b, alpha, alpha_dot):
 
 
 # ---------------------------------------------------------------------------
-# Increments
+# 3. Increments
 # ---------------------------------------------------------------------------
 def _state(motion, t_hi, t_lo, table):
     """The motion's state at the IMU point: a motion whose IMU point moves with
@@ -239,7 +283,7 @@ def _increments_block(motion, ticks, dt, t0, table, x, w):
     return half * dtheta, half * dv
 
 
-def node_rates(motion, ticks, dt=0.01, t0=0.0, nodes=5):
+def node_rates(motion, ticks, dt=DT, t0=0.0, nodes=5):
     """The ship's omega_ib^b and f^b at the Gauss-Legendre nodes of ticks.
 
     Returns ``(omega (n, nodes, 3), force (n, nodes, 3), x, w)`` with x, w the
@@ -266,10 +310,10 @@ def _table_angle_end(table, ticks, dt, t0):
         return np.zeros(len(ticks))
     t_hi, t_lo = split_times(ticks + 1, dt, t0)
     alpha, _ = table.state(t_hi, t_lo)
-    return wrap_two_pi(alpha)
+    return wrap_two_pi_mod(alpha)
 
 
-def exact_increments(motion, n_ticks, dt=0.01, t0=0.0, table=None, nodes=5, start_tick=0):
+def exact_increments(motion, n_ticks, dt=DT, t0=0.0, table=None, nodes=5, start_tick=0):
     """Exact angle and velocity increments in the IMU frame p.
 
     Parameters
@@ -321,7 +365,7 @@ def exact_increments(motion, n_ticks, dt=0.01, t0=0.0, table=None, nodes=5, star
 
 
 # ---------------------------------------------------------------------------
-# Truth
+# 4. Truth
 # ---------------------------------------------------------------------------
 @dataclass
 class Truth:
@@ -354,7 +398,7 @@ class Truth:
                 setattr(self, "imu_" + name, np.array(getattr(self, name), copy=True))
 
 
-def truth(motion, n_ticks, dt=0.01, t0=0.0, table=None, start_tick=0):
+def truth(motion, n_ticks, dt=DT, t0=0.0, table=None, start_tick=0):
     """True state at the end of ticks start_tick .. start_tick + n_ticks - 1.
 
     Parameters are those of `exact_increments`. Returns a `Truth`.
@@ -363,7 +407,7 @@ def truth(motion, n_ticks, dt=0.01, t0=0.0, table=None, start_tick=0):
     return truth_at(motion, ticks + 1, dt=dt, t0=t0, table=table)
 
 
-def truth_at(motion, sample_ticks, dt=0.01, t0=0.0, table=None):
+def truth_at(motion, sample_ticks, dt=DT, t0=0.0, table=None):
     """True state at the end of the given ticks: sample number k ends at t0 + k dt.
 
     ``sample_ticks`` may be any int array (e.g. the ``tick`` field of
@@ -374,7 +418,7 @@ def truth_at(motion, sample_ticks, dt=0.01, t0=0.0, table=None):
     st = _state(motion, t_hi, t_lo, table)
     ref = motion.reference_state(t_hi, t_lo) if hasattr(motion, "reference_state") else st
     euler = st.euler.copy()
-    euler[:, 2] = wrap_pi(euler[:, 2])
+    euler[:, 2] = wrap_pi_mod(euler[:, 2])
     return Truth(tick=ticks + 1, time=t_hi + t_lo, lat=ref.lat, lon=ref.lon,
                  height=ref.height, vel_n=ref.vel_n, quat_nb=euler_to_quat(st.euler),
                  euler=euler, table_angle=_table_angle_end(table, ticks, dt, t0),
@@ -383,7 +427,7 @@ def truth_at(motion, sample_ticks, dt=0.01, t0=0.0, table=None):
 
 
 # ---------------------------------------------------------------------------
-# Chunked generation
+# 5. Chunked generation
 # ---------------------------------------------------------------------------
 @dataclass
 class Chunk:
@@ -403,7 +447,7 @@ class Chunk:
     truth: Truth = None         #: true state at the sample instants, or None
 
 
-def generate(motion, duration_ticks, chunk_ticks=50000, dt=0.01, t0=0.0, table=None,
+def generate(motion, duration_ticks, chunk_ticks=50000, dt=DT, t0=0.0, table=None,
              sensors=None, nodes=5, with_truth=True):
     """Yield a run as `Chunk` objects of at most ``chunk_ticks`` samples.
 

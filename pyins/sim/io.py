@@ -2,7 +2,7 @@
 
 One row per 10-ms sample: tick number, angle increment dtheta_p [rad] and
 velocity increment dv_p [m/s] over the tick in the IMU frame p, and the
-table (encoder) angle at the end of the tick [rad] (DESIGN.md section 3).
+table (encoder) angle at the end of the tick [rad] (docs/design.md §3).
 
 - .npz: arrays ``tick`` (int64), ``dtheta_p`` (N, 3), ``dv_p`` (N, 3),
   ``table_angle_rad`` (N,), the scalar ``dt`` [s] and ``metadata``, a JSON

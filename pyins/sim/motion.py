@@ -1,4 +1,4 @@
-"""Analytic ship and turntable motion profiles.
+"""Ship motion: the analytic base profiles of the simulator.
 
 Every ship profile is an object with a method ``state(t, t_lo=None)`` that
 takes a 1-D array of times [s] from the start of the profile and returns a
@@ -10,121 +10,50 @@ force by Gauss-Legendre quadrature to double precision. The one exception is
 the position of a moving ship (`Manoeuvre`), which is integrated once,
 numerically, to double precision.
 
-Conventions (DESIGN.md section 2): C_b^n = Rz(yaw) Rx(pitch) Ry(roll); yaw is
+1. The state and the base class: `MotionState`, `Motion`.
+2. At a fixed position: `Static`, `Swing` and the sea states of seed 000
+   (`SEA_STATES`, `sea_state`), `HeadingSwing` with the set-up of seed 002
+   (``SEED002_*``).
+3. Under way: `Segment`, `default_segments`, `Manoeuvre`.
+
+The sea around a moored ship (heave, surge, sway, lever arms, wave spectra)
+is `pyins.sim.ship`; the turntable's profiles are `pyins.sim.turntable`.
+
+Conventions (docs/design.md §2): C_b^n = Rz(yaw) Rx(pitch) Ry(roll); yaw is
 counter-clockwise positive from North (marine heading = (-yaw) mod 2 pi);
 b is x starboard, y bow, z up. SI units.
 
 Time representation
 -------------------
 ``t_lo`` is an optional low-order part of the time: the time meant is the
-exact sum ``t + t_lo``. `pyins.sim.imu` builds node times as such pairs
-(`split_times`) so that a 24-h or 72-h run keeps sinusoid phases exact to
-~1e-16 rad instead of ulp(2 pi f t) ~ 1e-11 rad: the phase is reduced to a
-fraction of a cycle with error-free products (`frac_cycles`). Users may
-ignore ``t_lo``.
+exact sum ``t + t_lo`` (`pyins.sim.exact_time`). `pyins.sim.imu` builds node
+times as such pairs (`split_times`) so that a 24-h or 72-h run keeps sinusoid
+phases exact to ~1e-16 rad instead of ulp(2 pi f t) ~ 1e-11 rad: the phase is
+reduced to a fraction of a cycle with error-free products (`frac_cycles`).
+Users may ignore ``t_lo``.
 
 References
 ----------
 - Qin Yongyuan, "Inertial Navigation" (2nd ed., 2014), sec. 4.1: position
   rates lat_dot = vN / (R_M + h), lon_dot = vE / ((R_N + h) cos lat).
-- Seed 000, Table 2 (sea states); seed 002, sec. 3 (heading-swing profiles
-  and Table 1 initial state); see SPEC.md sections 2.2 and 1.7.
-- Dekker (1971), "A floating-point technique for extending the available
-  precision", Numer. Math. 18: the two-product and two-sum used here.
+- Seed 000, Table 2 (sea states), docs/papers.md, seed 000 §2; seed 002,
+  sec. 3 (heading-swing profiles) and Table 1 (initial state),
+  docs/papers.md, seed 002 §7.
 """
+
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial.legendre import leggauss
 
 from pyins.reference import earth
-
-TWO_PI = 2.0 * np.pi
-
-# ---------------------------------------------------------------------------
-# Error-free transformations (Dekker 1971), vectorised, no FMA needed.
-# ---------------------------------------------------------------------------
-_SPLITTER = 134217729.0  # 2**27 + 1
-
-
-def _split(a):
-    c = _SPLITTER * a
-    hi = c - (c - a)
-    return hi, a - hi
-
-
-def two_prod(a, b):
-    """``a * b == p + e`` exactly (Dekker's product; inputs well below 1e300)."""
-    p = a * b
-    a_hi, a_lo = _split(a)
-    b_hi, b_lo = _split(b)
-    e = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
-    return p, e
-
-
-def two_sum(a, b):
-    """``a + b == s + e`` exactly (Knuth's two-sum)."""
-    s = a + b
-    bb = s - a
-    e = (a - (s - bb)) + (b - bb)
-    return s, e
-
-
-def split_times(ticks, dt, t0=0.0, frac=0.0):
-    """Times ``t0 + (ticks + frac) * dt`` as an exact pair ``(t_hi, t_lo)``.
-
-    Parameters
-    ----------
-    ticks : array_like of int
-        Tick indices (exact in float64 below 2**53).
-    dt : float
-        Tick length [s].
-    t0 : float
-        Time of tick 0 [s].
-    frac : array_like
-        Fraction of a tick in [0, 1], broadcast against ``ticks``.
-
-    Returns
-    -------
-    t_hi, t_lo : ndarray
-        ``t_hi + t_lo`` equals the time to ~1e-27 s; ``t_lo`` may be as large
-        as one tick (it carries the in-tick offset).
-    """
-    g = np.asarray(ticks, dtype=float)
-    p, e1 = two_prod(g, dt)
-    t_hi, e2 = two_sum(np.full_like(p, t0), p)
-    t_lo = (e1 + e2) + np.asarray(frac, dtype=float) * dt
-    t_hi, t_lo = np.broadcast_arrays(t_hi, t_lo)
-    return np.array(t_hi), np.array(t_lo)
-
-
-def frac_cycles(freq, t, t_lo=None):
-    """``freq * (t + t_lo)`` reduced to a fraction of a cycle, about [-0.5, 0.5].
-
-    The product ``freq * t`` is formed exactly (two-product), its integer part
-    removed exactly, and the low-order parts added afterwards, so the result is
-    accurate to ~1e-16 cycles whatever the size of ``t``.
-    """
-    p, e = two_prod(freq, t)
-    n = np.rint(p)
-    c = (p - n) + e
-    if t_lo is not None:
-        c = c + freq * t_lo
-    return c
-
-
-def _times(t, t_lo):
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    if t.ndim != 1:
-        raise ValueError(f"times must be a 1-D array, got shape {t.shape}")
-    if t_lo is None:
-        return t, None
-    t_lo = np.broadcast_to(np.asarray(t_lo, dtype=float), t.shape)
-    return t, t_lo
+from pyins.sim.exact_time import as_times, frac_cycles
+from pyins.sim.turntable import ConstantRate, Fixed  # re-exported for callers outside pyins.sim
+from pyins.units import DEG_TO_RAD, DT, TWO_PI
 
 
 # ---------------------------------------------------------------------------
-# Ship motion
+# 1. The state and the base class
 # ---------------------------------------------------------------------------
 @dataclass
 class MotionState:
@@ -152,6 +81,9 @@ class Motion:
         raise NotImplementedError
 
 
+# ---------------------------------------------------------------------------
+# 2. At a fixed position
+# ---------------------------------------------------------------------------
 def _fixed_position(obj, n):
     return (np.full(n, obj.lat), np.full(n, obj.lon), np.full(n, obj.height))
 
@@ -174,7 +106,7 @@ class Static(Motion):
         self.euler0 = np.array([pitch, roll, yaw], dtype=float)
 
     def state(self, t, t_lo=None):
-        t, _ = _times(t, t_lo)
+        t, _ = as_times(t, t_lo)
         n = t.shape[0]
         lat, lon, h = _fixed_position(self, n)
         zeros = np.zeros((n, 3))
@@ -183,7 +115,7 @@ class Static(Motion):
 
     def euler_accel(self, t, t_lo=None):
         """Second derivative of the Euler angles [rad/s^2], (N, 3): zero."""
-        t, _ = _times(t, t_lo)
+        t, _ = as_times(t, t_lo)
         return np.zeros((t.shape[0], 3))
 
 
@@ -222,7 +154,7 @@ class Swing(Motion):
         return sea_state(name, lat, lon, height, yaw0, pitch0, roll0, phase)
 
     def state(self, t, t_lo=None):
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         n = t.shape[0]
         euler = np.empty((n, 3))
         rate = np.empty((n, 3))
@@ -241,7 +173,7 @@ class Swing(Motion):
         ``-amplitude (2 pi f)^2 sin(phase)``, the phase formed exactly as in
         `state` (so HeadingSwing gets ``-A (2 pi / T) sin(2 pi t / T)``).
         """
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         acc = np.empty((t.shape[0], 3))
         for j in range(3):
             phase = TWO_PI * frac_cycles(self.frequency_hz[j], t, t_lo) + self.phase[j]
@@ -252,7 +184,7 @@ class Swing(Motion):
 
 #: Seed 000 Table 2, the three-axis turntable swing profiles:
 #: ``name -> {frame: (amplitude [deg], frequency [Hz])}`` for the inner,
-#: middle and outer frames, as printed (SPEC.md section 2.2).
+#: middle and outer frames, as printed (docs/papers.md, seed 000 §2).
 SEA_STATES = {
     "general": {"inner": (10.0, 0.125), "middle": (4.0, 0.2), "outer": (4.0, 0.2)},
     "ideal": {"inner": (3.0, 0.06), "middle": (2.5, 0.08), "outer": (2.0, 0.08)},
@@ -262,7 +194,7 @@ SEA_STATES = {
 
 def sea_state(name, lat, lon, height, yaw0, pitch0=0.0, roll0=0.0,
               phase=(0.0, 0.0, 0.0)):
-    """Swing profile of one sea state of seed 000 Table 2.
+    """Swing profile of one sea state of seed 000 Table 2 (docs/papers.md, seed 000 §2).
 
     Mapping of the turntable frames onto the Euler angles: the sequence
     C_b^n = Rz(yaw) Rx(pitch) Ry(roll) is itself the outer-middle-inner gimbal
@@ -292,25 +224,27 @@ def sea_state(name, lat, lon, height, yaw0, pitch0=0.0, roll0=0.0,
     s = SEA_STATES[name]
     amp_deg = [s["middle"][0], s["inner"][0], s["outer"][0]]   # pitch, roll, yaw
     freq = [s["middle"][1], s["inner"][1], s["outer"][1]]
-    amp = np.array(amp_deg) * earth.DEG_TO_RAD
+    amp = np.array(amp_deg) * DEG_TO_RAD
     return Swing(lat, lon, height, pitch0, roll0, yaw0, amp, freq, phase)
 
 
-#: Seed 002 Table 1 initial state (SPEC.md section 1.7): position of Xi'an and
-#: the IMU attitude pitch 1 deg, roll -2 deg, IMU heading 15 deg (yaw -15 deg).
-SEED002_LAT = 34.246 * earth.DEG_TO_RAD
-SEED002_LON = 108.910 * earth.DEG_TO_RAD
+#: Seed 002 Table 1 initial state (docs/papers.md, seed 002 §7): position of
+#: Xi'an and the IMU attitude pitch 1 deg, roll -2 deg, IMU heading 15 deg
+#: (yaw -15 deg).
+SEED002_LAT = 34.246 * DEG_TO_RAD
+SEED002_LON = 108.910 * DEG_TO_RAD
 SEED002_HEIGHT = 380.0
-SEED002_PITCH = 1.0 * earth.DEG_TO_RAD
-SEED002_ROLL = -2.0 * earth.DEG_TO_RAD
-SEED002_YAW = -15.0 * earth.DEG_TO_RAD
+SEED002_PITCH = 1.0 * DEG_TO_RAD
+SEED002_ROLL = -2.0 * DEG_TO_RAD
+SEED002_YAW = -15.0 * DEG_TO_RAD
 #: Heading-swing experiments of seed 002: number -> (rate amplitude [deg/s],
-#: period [s]), omega(t) = 6 cos(2 pi t / T) deg/s (SPEC.md section 1.7).
+#: period [s]), omega(t) = 6 cos(2 pi t / T) deg/s (docs/papers.md, seed 002 §7).
 SEED002_EXPERIMENTS = {1: (6.0, 120.0), 2: (6.0, 60.0)}
 
 
 class HeadingSwing(Swing):
-    """Heading-only swing of seed 002: yaw rate ``A cos(2 pi t / T)``.
+    """Heading-only swing of seed 002: yaw rate ``A cos(2 pi t / T)``
+    (docs/papers.md, seed 002 §7).
 
     yaw(t) = yaw0 + A T / (2 pi) sin(2 pi t / T); pitch and roll held
     constant; position fixed; velocity zero. The up-axis rate is taken
@@ -351,9 +285,12 @@ class HeadingSwing(Swing):
             raise ValueError(f"seed 002 has experiments 1 and 2, not {number!r}")
         a_deg, period = SEED002_EXPERIMENTS[number]
         return cls(SEED002_LAT, SEED002_LON, SEED002_HEIGHT, SEED002_PITCH,
-                   SEED002_ROLL, yaw0, a_deg * earth.DEG_TO_RAD, period)
+                   SEED002_ROLL, yaw0, a_deg * DEG_TO_RAD, period)
 
 
+# ---------------------------------------------------------------------------
+# 3. Under way
+# ---------------------------------------------------------------------------
 @dataclass
 class Segment:
     """One leg of a `Manoeuvre`.
@@ -369,7 +306,7 @@ class Segment:
     value: float = 0.0
 
 
-def default_segments(dt=0.01):
+def default_segments(dt=DT):
     """The default 30-min manoeuvre (1800 s), durations rounded to ticks of ``dt``.
 
     accelerate 0 -> 10 m/s in 120 s; cruise 300 s; turn +90 deg (yaw,
@@ -379,8 +316,8 @@ def default_segments(dt=0.01):
     longitudinal acceleration 0.17 m/s^2.
     """
     legs = [("accelerate", 120.0, 10.0), ("cruise", 300.0, 0.0),
-            ("turn", 60.0, 90.0 * earth.DEG_TO_RAD), ("cruise", 300.0, 0.0),
-            ("turn", 90.0, -135.0 * earth.DEG_TO_RAD), ("cruise", 300.0, 0.0),
+            ("turn", 60.0, 90.0 * DEG_TO_RAD), ("cruise", 300.0, 0.0),
+            ("turn", 90.0, -135.0 * DEG_TO_RAD), ("cruise", 300.0, 0.0),
             ("decelerate", 120.0, 0.0), ("cruise", 510.0, 0.0)]
     return [Segment(kind, _seconds_to_ticks(sec, dt), value) for kind, sec, value in legs]
 
@@ -449,7 +386,7 @@ class Manoeuvre(Motion):
     _MAX_ITER = 50
     _TOL = 1e-15
 
-    def __init__(self, lat, lon, height, yaw0, segments, dt=0.01, speed0=0.0,
+    def __init__(self, lat, lon, height, yaw0, segments, dt=DT, speed0=0.0,
                  pitch=0.0, roll=0.0, nodes=5):
         self.lat0, self.lon0, self.height = float(lat), float(lon), float(height)
         self.yaw0 = float(yaw0)
@@ -498,7 +435,7 @@ class Manoeuvre(Motion):
         self._dlon = None
 
     @classmethod
-    def default(cls, lat, lon, height, yaw0, dt=0.01, **kwargs):
+    def default(cls, lat, lon, height, yaw0, dt=DT, **kwargs):
         """The 30-min default manoeuvre (`default_segments`)."""
         return cls(lat, lon, height, yaw0, default_segments(dt), dt=dt, **kwargs)
 
@@ -605,7 +542,7 @@ class Manoeuvre(Motion):
         return self.lat0 + self._dlat, self.lon0 + self._dlon
 
     def state(self, t, t_lo=None):
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         if t_lo is not None:
             t = t + t_lo
         if t.size and (np.min(t) < -1e-9 or np.max(t) > self.duration + 1e-9):
@@ -638,62 +575,3 @@ class Manoeuvre(Motion):
         rate = np.zeros((n, 3))
         rate[:, 2] = yaw_rate
         return MotionState(lat, lon, np.full(n, self.height), vel, acc, euler, rate)
-
-
-# ---------------------------------------------------------------------------
-# Turntable motion
-# ---------------------------------------------------------------------------
-class TableMotion:
-    """Base class of turntable profiles: ``state(t, t_lo=None) -> (alpha, alpha_dot)``.
-
-    alpha is the table angle [rad] (C_p^b = Rz(alpha), counter-clockwise seen
-    from above), alpha_dot its rate [rad/s]. alpha may be returned reduced by
-    whole turns; callers wrap it. ``state3`` adds the exact angular
-    acceleration [rad/s^2], needed when the accelerometer triad sits off the
-    table axis (``lever_p`` of `pyins.sim.ship.ShipAtSea`).
-    """
-
-    def state(self, t, t_lo=None):
-        raise NotImplementedError
-
-    def state3(self, t, t_lo=None):
-        """``(alpha, alpha_dot, alpha_ddot)`` at the times, each (N,)."""
-        raise NotImplementedError(f"{type(self).__name__} gives no angular acceleration "
-                                  f"(state3), which a rotating lever_p needs")
-
-
-class Fixed(TableMotion):
-    """Turntable held at ``alpha0`` [rad]."""
-
-    def __init__(self, alpha0=0.0):
-        self.alpha0 = float(alpha0)
-
-    def state(self, t, t_lo=None):
-        t, _ = _times(t, t_lo)
-        return np.full(t.shape, self.alpha0), np.zeros(t.shape)
-
-    def state3(self, t, t_lo=None):
-        alpha, rate = self.state(t, t_lo)
-        return alpha, rate, np.zeros(alpha.shape)
-
-
-class ConstantRate(TableMotion):
-    """Turntable turning at a constant ``rate`` [rad/s] from ``alpha0`` [rad].
-
-    alpha(t) = alpha0 + rate t, with whole turns removed exactly (the turn
-    count rate t / (2 pi) is reduced with `frac_cycles`).
-    """
-
-    def __init__(self, rate, alpha0=0.0):
-        self.rate = float(rate)
-        self.alpha0 = float(alpha0)
-        self._cycles_per_s = self.rate / TWO_PI
-
-    def state(self, t, t_lo=None):
-        t, t_lo = _times(t, t_lo)
-        alpha = self.alpha0 + TWO_PI * frac_cycles(self._cycles_per_s, t, t_lo)
-        return alpha, np.full(t.shape, self.rate)
-
-    def state3(self, t, t_lo=None):
-        alpha, rate = self.state(t, t_lo)
-        return alpha, rate, np.zeros(alpha.shape)

@@ -1,6 +1,6 @@
 """Sensor error model of the gyro and accelerometer triads (IMU frame p).
 
-Per tick, for each triad (seed 002 eq. (1), SPEC.md section 1.4):
+Per tick, for each triad (seed 002 eq. (1), docs/papers.md, seed 002 §4):
 
     measured = (I + diag(scale) + misalignment) true + bias dt + w,
     w ~ N(0, (random_walk sqrt(dt))^2) per axis, independent between ticks,
@@ -20,18 +20,24 @@ about / along axis j [rad]; its diagonal is zero.
 Units: SI. gyro_arw in rad/sqrt(s), accel_vrw in (m/s)/sqrt(s). The
 conversions used by the presets: 1 deg/sqrt(h) = DEG_TO_RAD / 60 rad/sqrt(s);
 1 ug/sqrt(Hz) = UG_TO_MPS2 (m/s^2)/sqrt(Hz), which is numerically the same in
-(m/s)/sqrt(s); 1 ug = 1e-6 * 9.80665 m/s^2 (``earth.UG_TO_MPS2``).
+(m/s)/sqrt(s); 1 ug = 1e-6 * 9.80665 m/s^2 (``pyins.units.UG_TO_MPS2``).
+
+1. The errors: `SensorErrors`.
+2. The pulse counter: `_Quantiser`.
+3. The model applied chunk by chunk: `SensorModel`.
+4. The presets: `PRESETS`, `preset` (the papers' sensor set-ups as the
+   project reads them, docs/papers.md).
 """
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pyins.reference import earth
+from pyins.units import ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS, DT, UG_TO_MPS2
 
 #: deg/sqrt(h) -> rad/sqrt(s)
-DPSH_TO_RPSS = earth.DEG_TO_RAD / 60.0
+DPSH_TO_RPSS = DEG_TO_RAD / 60.0
 #: ug/sqrt(Hz) -> (m/s)/sqrt(s)
-UGPSHZ_TO_MPSPSS = earth.UG_TO_MPS2
+UGPSHZ_TO_MPSPSS = UG_TO_MPS2
 #: ppm -> dimensionless
 PPM = 1e-6
 
@@ -39,6 +45,9 @@ PPM = 1e-6
 QUANTISER_RESET_TICKS = 1 << 16
 
 
+# ---------------------------------------------------------------------------
+# 1. The errors
+# ---------------------------------------------------------------------------
 def _vec3():
     return field(default_factory=lambda: np.zeros(3))
 
@@ -83,6 +92,9 @@ class SensorErrors:
             setattr(self, name, v)
 
 
+# ---------------------------------------------------------------------------
+# 2. The pulse counter
+# ---------------------------------------------------------------------------
 class _Quantiser:
     """Pulse counter of one triad (see the module docstring)."""
 
@@ -120,6 +132,9 @@ class _Quantiser:
         return self.sum - self.quantum * self.count
 
 
+# ---------------------------------------------------------------------------
+# 3. The model, chunk by chunk
+# ---------------------------------------------------------------------------
 def _apply_matrix(scale, mis, x):
     """x + (diag(scale) + mis) x, element-wise (no BLAS)."""
     out = np.empty_like(x)
@@ -148,7 +163,7 @@ class SensorModel:
         Tick length [s].
     """
 
-    def __init__(self, errors, seed, dt=0.01):
+    def __init__(self, errors, seed, dt=DT):
         self.errors = errors
         self.seed = seed
         self.dt = float(dt)
@@ -181,11 +196,11 @@ class SensorModel:
 
 
 # ---------------------------------------------------------------------------
-# Presets
+# 4. Presets
 # ---------------------------------------------------------------------------
-_AS = earth.ARCSEC_TO_RAD
-_DPH = earth.DPH_TO_RPS
-_UG = earth.UG_TO_MPS2
+_AS = ARCSEC_TO_RAD
+_DPH = DPH_TO_RPS
+_UG = UG_TO_MPS2
 
 #: Seed 003 installation-error matrix (both triads), [rad].
 _SEED003_MIS = np.array([[0.0, -2.0, 2.0], [2.0, 0.0, -2.0], [-2.0, 2.0, 0.0]]) * _AS
@@ -193,26 +208,26 @@ _SEED003_MIS = np.array([[0.0, -2.0, 2.0], [2.0, 0.0, -2.0], [-2.0, 2.0, 0.0]]) 
 PRESETS = {
     # No errors at all: the output is the exact increments.
     "error_free": SensorErrors(),
-    # Seed 000 (SPEC 2.2; seeds/000_*.txt line 125, Fig. 1): the smallest
+    # Seed 000 (docs/papers.md, seed 000 §2; the paper's Fig. 1): the smallest
     # simulated levels, gyro drift 0.01 deg/h and accelerometer bias 0.1 mg =
     # 100 ug. The paper states no noise, scale-factor, misalignment or
     # quantisation figures for its simulation (and none for its 90-type RLG
     # IMU), so they are zero here.
     "seed000": SensorErrors(gyro_bias=np.full(3, 0.01 * _DPH),
                             accel_bias=np.full(3, 100.0 * _UG)),
-    # Seed 001 (SPEC 3.3): drift [0.01 0.01 0.01] deg/h; gyro noise
-    # Q = diag(1e-3 deg/h)^2 "as printed", interpreted as an ARW of
+    # Seed 001 (docs/papers.md, seed 001 §3): drift [0.01 0.01 0.01] deg/h;
+    # gyro noise Q = diag(1e-3 deg/h)^2 "as printed", interpreted as an ARW of
     # 0.001 deg/sqrt(h); accelerometer bias 100 ug; accelerometer noise
     # Q = diag(10 ug)^2 interpreted as a VRW of 10 ug/sqrt(Hz).
     "seed001": SensorErrors(gyro_bias=np.full(3, 0.01 * _DPH),
                             gyro_arw=0.001 * DPSH_TO_RPSS,
                             accel_bias=np.full(3, 100.0 * _UG),
                             accel_vrw=10.0 * UGPSHZ_TO_MPSPSS),
-    # Seed 002 (SPEC 1.7 Table 2): drift 0.003 deg/h, bias 30 ug (ug likely),
-    # ARW 0.0005 deg/sqrt(h), VRW 5 ug/sqrt(Hz) (likely), scale factors
-    # 10 ppm on both triads (likely), six gyro installation terms 10" (all
-    # off-diagonal), three accelerometer terms 10" in the lower triangle
-    # (K_ayx, K_azx, K_azy: lower-triangular model).
+    # Seed 002 (docs/papers.md, seed 002 §7, Table 2): drift 0.003 deg/h,
+    # bias 30 ug (ug likely), ARW 0.0005 deg/sqrt(h), VRW 5 ug/sqrt(Hz)
+    # (likely), scale factors 10 ppm on both triads (likely), six gyro
+    # installation terms 10" (all off-diagonal), three accelerometer terms
+    # 10" in the lower triangle (K_ayx, K_azx, K_azy: lower-triangular model).
     "seed002": SensorErrors(gyro_bias=np.full(3, 0.003 * _DPH),
                             gyro_scale=np.full(3, 10.0 * PPM),
                             gyro_misalignment=(np.ones((3, 3)) - np.eye(3)) * 10.0 * _AS,
@@ -221,11 +236,11 @@ PRESETS = {
                             accel_scale=np.full(3, 10.0 * PPM),
                             accel_misalignment=np.tril(np.ones((3, 3)), -1) * 10.0 * _AS,
                             accel_vrw=5.0 * UGPSHZ_TO_MPSPSS),
-    # Seed 003 (SPEC 4.3): drift 0.003 deg/h; "random error 0.0005 deg/h"
-    # interpreted as ARW 0.0005 deg/sqrt(h); gyro scale-factor 0.466 ppm;
-    # accelerometer bias 20 ug, scale factor 20 ppm; installation matrix
-    # [0, -2", 2"; 2", 0, -2"; -2", 2", 0] for both triads. No accelerometer
-    # noise is given (zero). The paper's 1-s sampling is not copied: the
+    # Seed 003 (docs/papers.md, seed 003 §3): drift 0.003 deg/h; "random
+    # error 0.0005 deg/h" interpreted as ARW 0.0005 deg/sqrt(h); gyro
+    # scale-factor 0.466 ppm; accelerometer bias 20 ug, scale factor 20 ppm;
+    # installation matrix [0, -2", 2"; 2", 0, -2"; -2", 2", 0] for both
+    # triads. No accelerometer noise is given (zero). The paper's 1-s sampling is not copied: the
     # model runs at the caller's dt.
     "seed003": SensorErrors(gyro_bias=np.full(3, 0.003 * _DPH),
                             gyro_scale=np.full(3, 0.466 * PPM),

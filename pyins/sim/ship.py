@@ -8,6 +8,13 @@ point, both closed form, so `pyins.sim.imu.exact_increments` stays exact).
 `sea_spectrum_motion` draws a `LinearMotion` from a wave spectrum (presets
 `SEA_STATE_SPECTRA`); `moored` is the built-in moored ship (`MOORED_SHIP`).
 
+1. Heave, surge, sway: `LinearMotion`.
+2. The ship at sea, lever arms included: `ShipAtSea`.
+3. Wave spectra and the ship's response: `pierson_moskowitz`, `jonswap`,
+   `dnv_gamma`, `heave_response`, `sea_spectrum_motion`, `SEA_STATE_SPECTRA`,
+   `named_sea_spectrum`.
+4. The built-in moored ship: `MOORED_SHIP`, `moored`.
+
 Positions (exact by definition)
 -------------------------------
 A point whose ENU offset from the site (lat0, lon0, h0) is D = (dE, dN, dU)
@@ -38,9 +45,9 @@ D_imu = d + C_b^n r_b with r_b = lever_b + Rz(alpha) lever_p, so
     D_imu'  = d' + C (w x r + r')
     D_imu'' = d'' + C (w x (w x r) + w' x r + 2 w x r' + r'')
 
-with w = omega_nb^b from the Euler angles and rates (the formula of
-`pyins.sim.imu.body_rate_and_force`) and w' its exact derivative from the
-Euler accelerations (``euler_accel`` of the base profile); dC/dt = C [w x]
+with w = omega_nb^b from the Euler angles and rates and w' its exact
+derivative from the Euler accelerations (``euler_accel`` of the base
+profile), both by `pyins.sim.imu.nb_rate_and_derivative`; dC/dt = C [w x]
 (Qin 2014 sec. 9.1; the lever-arm terms as in Titterton & Weston,
 "Strapdown Inertial Navigation Technology", 2nd ed., 2004).
 
@@ -64,9 +71,10 @@ import numbers
 import numpy as np
 
 from pyins.reference import earth
-from pyins.sim.imu import euler_to_mat
-from pyins.sim.motion import (TWO_PI, Manoeuvre, Motion, MotionState, Static, Swing,
-                              _times, frac_cycles, sea_state)
+from pyins.sim.exact_time import as_times, frac_cycles
+from pyins.sim.imu import euler_to_mat, nb_rate_and_derivative
+from pyins.sim.motion import Manoeuvre, Motion, MotionState, Static, Swing, sea_state
+from pyins.units import DT, TWO_PI
 
 #: Largest linear-motion amplitude and lever-arm length accepted [m].
 MAX_METRES = 100.0
@@ -134,13 +142,13 @@ def _positive(field, value, unit):
 
 
 # ---------------------------------------------------------------------------
-# Heave, surge, sway
+# 1. Heave, surge, sway
 # ---------------------------------------------------------------------------
 class LinearMotion:
     """Heave, surge and sway of the motion reference point about a fixed mean position.
 
     Each axis is a sum of ``a sin(2 pi (t + t_lo) / T + phase)``, with the
-    phase reduced exactly by `pyins.sim.motion.frac_cycles` (exact over 72 h,
+    phase reduced exactly by `pyins.sim.exact_time.frac_cycles` (exact over 72 h,
     as `Swing`). The axes are those of a fixed level frame along the ship's
     MEAN heading: x = sway (mean starboard), y = surge (mean bow), z = heave
     (up); `ShipAtSea` rotates it into ENU with the base profile's mean yaw.
@@ -182,7 +190,7 @@ class LinearMotion:
 
         Columns [sway, surge, heave] [m, m/s, m/s^2].
         """
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         out = [np.empty((t.shape[0], 3)) for _ in range(3)]
         for j, comps in enumerate((self.sway, self.surge, self.heave)):
             for k, col in enumerate(self._axis(comps, t, t_lo)):
@@ -210,34 +218,8 @@ class LinearMotion:
 
 
 # ---------------------------------------------------------------------------
-# Body rate and its derivative from Euler angles
+# Lever-arm arithmetic
 # ---------------------------------------------------------------------------
-def nb_rate_and_derivative(euler, euler_rate, euler_accel):
-    """omega_nb^b and its time derivative [rad/s, rad/s^2], (N, 3) each.
-
-    omega_nb^b = Ry(roll)^T (Rx(pitch)^T [0, 0, yaw'] + [pitch', 0, 0]) + [0, roll', 0]
-    (as in `pyins.sim.imu.body_rate_and_force`), differentiated term by term.
-    """
-    p, r = euler[:, 0], euler[:, 1]
-    dp, dr, dy = euler_rate[:, 0], euler_rate[:, 1], euler_rate[:, 2]
-    ddp, ddr, ddy = euler_accel[:, 0], euler_accel[:, 1], euler_accel[:, 2]
-    sp, cp = np.sin(p), np.cos(p)
-    sr, cr = np.sin(r), np.cos(r)
-    u1 = sp * dy
-    u2 = cp * dy
-    du1 = cp * dp * dy + sp * ddy
-    du2 = -sp * dp * dy + cp * ddy
-    w = np.empty(euler.shape)
-    w[:, 0] = cr * dp - sr * u2
-    w[:, 1] = dr + u1
-    w[:, 2] = sr * dp + cr * u2
-    wd = np.empty(euler.shape)
-    wd[:, 0] = (cr * ddp - sr * dr * dp) - (cr * dr * u2 + sr * du2)
-    wd[:, 1] = ddr + du1
-    wd[:, 2] = (sr * ddp + cr * dr * dp) + (cr * du2 - sr * dr * u2)
-    return w, wd
-
-
 def _cross(a, b):
     out = np.empty(np.broadcast_shapes(a.shape, b.shape))
     out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
@@ -255,7 +237,7 @@ def _mat_vec(m, v):
 
 
 # ---------------------------------------------------------------------------
-# Ship at sea
+# 2. Ship at sea
 # ---------------------------------------------------------------------------
 class ShipAtSea(Motion):
     """A fixed-position base profile plus heave/surge/sway and lever arms.
@@ -385,17 +367,17 @@ class ShipAtSea(Motion):
 
     def reference_state(self, t, t_lo=None):
         """MotionState of the motion reference point (offset d(t) only)."""
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         base_st = self.base.state(t, t_lo)
         return self._geodetic(*self._displacement(t, t_lo), base_st)
 
     def state(self, t, t_lo=None, table=None):
         """MotionState of the IMU point.
 
-        ``table`` (a `pyins.sim.motion.TableMotion`) is needed only with a
+        ``table`` (a `pyins.sim.turntable.TableMotion`) is needed only with a
         non-zero ``lever_p``; None means alpha = 0 (p = b).
         """
-        t, t_lo = _times(t, t_lo)
+        t, t_lo = as_times(t, t_lo)
         base_st = self.base.state(t, t_lo)
         d, d_d, d_dd = self._displacement(t, t_lo)
         if np.any(self.lever_b != 0.0) or self.needs_table:
@@ -417,7 +399,7 @@ class ShipAtSea(Motion):
 
 
 # ---------------------------------------------------------------------------
-# Wave spectra and the ship's response
+# 3. Wave spectra and the ship's response
 # ---------------------------------------------------------------------------
 def pierson_moskowitz(omega, hs, tp):
     """Modified (two-parameter) Pierson-Moskowitz spectrum S(w) [m^2 s/rad].
@@ -471,16 +453,16 @@ def heave_response(omega, natural_period=8.0, damping=0.3):
 
 def sea_spectrum_motion(hs, tp, spectrum="jonswap", gamma=3.3, seed=0, n_components=40,
                         band=(0.5, 3.0), natural_period=8.0, damping=0.3, surge_ratio=0.5,
-                        sway_ratio=0.4, period_step=0.01):
+                        sway_ratio=0.4, period_step=DT):
     """Heave, surge and sway of a moored ship in a sea of a standard spectrum.
 
     The band ``[band[0] wp, band[1] wp]`` (wp = 2 pi / Tp; the default holds
     98.5 % of the PM energy) is cut into ``n_components`` equal slices dw;
     the centre of each slice is turned into a period ROUNDED to a multiple of
-    ``period_step`` (0.01 s: whole ticks at 100 Hz, so the phases are exact
-    and the periods rational), and the component at w_i = 2 pi / T_i gets the
-    amplitude a_i = |H(w_i)| sqrt(2 S(w_i) dw) (Fossen 2011 ch. 8) and a
-    uniform random phase from ``numpy.random.default_rng(seed)`` (one draw
+    ``period_step`` (DT = 0.01 s: whole ticks at 100 Hz, so the phases are
+    exact and the periods rational), and the component at w_i = 2 pi / T_i
+    gets the amplitude a_i = |H(w_i)| sqrt(2 S(w_i) dw) (Fossen 2011 ch. 8)
+    and a uniform random phase from ``numpy.random.default_rng(seed)`` (one draw
     of shape (3, n): heave, surge, sway rows; independent per axis).
 
     Ship response: heave `heave_response` (natural period, damping ratio);
@@ -593,7 +575,7 @@ def named_sea_spectrum(name, seed=0, **overrides):
 
 
 # ---------------------------------------------------------------------------
-# The built-in moored ship
+# 4. The built-in moored ship
 # ---------------------------------------------------------------------------
 #: Default moored-ship linear motion and lever arm: heave 0.5 m at 8 s, surge
 #: 0.3 m at 12 s, sway 0.3 m at 10 s (amplitude [m], period [s], phase

@@ -5,10 +5,11 @@ import pytest
 from pyins.reference import attitude, earth
 from pyins.sim import imu
 from pyins.sim import motion as M
+from pyins.sim import turntable as T
 from pyins.sim.sensors import SensorModel, preset
+from pyins.units import DT
 
 D = earth.DEG_TO_RAD
-DT = 0.01
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
 
 
@@ -77,7 +78,7 @@ def test_static_increments_equal_earth_rate_and_gravity():
 
 def test_static_fast_path_equals_generic_path():
     st = M.Static(LAT, LON, HEIGHT, 0.01, 0.02, 1.0)
-    for table in (None, M.Fixed(1.2)):
+    for table in (None, T.Fixed(1.2)):
         fast = imu.exact_increments(st, 1000, table=table, start_tick=123)
         slow = imu.exact_increments(NotStatic(st), 1000, table=table, start_tick=123)
         assert np.max(np.abs(fast[0] - slow[0])) < 1e-18
@@ -107,7 +108,7 @@ def test_quadrature_converged(profile, request):
 @pytest.mark.parametrize("profile", ["bad_sea", "manoeuvre"])
 def test_chunks_are_bit_identical(profile, request):
     mo = request.getfixturevalue(profile)
-    table = M.ConstantRate(6.0 * D, 0.2)
+    table = T.ConstantRate(6.0 * D, 0.2)
     n = 70000
     one = imu.exact_increments(mo, n, table=table)
     parts = [imu.exact_increments(mo, k, table=table, start_tick=s)
@@ -121,7 +122,7 @@ def test_chunks_are_bit_identical(profile, request):
 
 
 def test_generate_matches_one_shot(bad_sea):
-    table = M.ConstantRate(-6.0 * D)
+    table = T.ConstantRate(-6.0 * D)
     n = 23456
     th, dv, angle = imu.exact_increments(bad_sea, n, table=table)
     model = SensorModel(preset("seed002"), seed=7)
@@ -156,7 +157,7 @@ def test_euler_to_quat_matches_reference():
 
 
 def test_truth_is_state_at_end_of_tick(manoeuvre):
-    table = M.ConstantRate(6.0 * D, 6.2)
+    table = T.ConstantRate(6.0 * D, 6.2)
     tr = imu.truth(manoeuvre, 300, table=table, t0=100.0, start_tick=10)
     np.testing.assert_array_equal(tr.tick, np.arange(11, 311))
     st = manoeuvre.state(100.0 + np.arange(11, 311) * DT)
@@ -204,7 +205,7 @@ def test_attitude_from_increments_matches_truth(bad_sea, with_table):
     # rad per tick; bound 1e-9 rad. A sign error gives ~1e-2 rad, a wrong
     # Earth-rate sign ~1e-6 rad, increments rotated into the tick-start frame
     # (i.e. already coning-corrected) ~2e-8 rad.
-    table = M.ConstantRate(6.0 * D, 0.4) if with_table else None
+    table = T.ConstantRate(6.0 * D, 0.4) if with_table else None
     assert np.max(np.abs(_attitude_residual(bad_sea, 3000, table=table))) < 1e-9
     # the check has teeth: without the coning term it fails
     assert np.max(np.abs(_attitude_residual(bad_sea, 3000, table=table, coning=False))) > 1e-9
@@ -268,7 +269,7 @@ def test_table_rate_enters_z_only():
     st = M.Static(LAT, LON, HEIGHT, 0.02, -0.01, 0.7)
     rate = 6.0 * D
     b, dvb, _ = imu.exact_increments(st, 200)
-    p, dvp, angle = imu.exact_increments(st, 200, table=M.ConstantRate(rate))
+    p, dvp, angle = imu.exact_increments(st, 200, table=T.ConstantRate(rate))
     shrink = np.sin(0.5 * rate * DT) / (0.5 * rate * DT)
     assert np.max(np.abs(p[:, 2] - (b[:, 2] + rate * DT))) < 1e-17
     assert np.max(np.abs(np.hypot(p[:, 0], p[:, 1]) - shrink * np.hypot(b[:, 0], b[:, 1]))) < 1e-21
@@ -277,7 +278,7 @@ def test_table_rate_enters_z_only():
     np.testing.assert_allclose(angle, rate * DT * np.arange(1, 201), rtol=0, atol=1e-14)
     # rotating the table by +alpha turns the body x axis by -alpha in p
     alpha = 0.5
-    q, _, _ = imu.exact_increments(st, 1, table=M.Fixed(alpha))
+    q, _, _ = imu.exact_increments(st, 1, table=T.Fixed(alpha))
     ca, sa = np.cos(alpha), np.sin(alpha)
     expected = np.array([ca * b[0, 0] + sa * b[0, 1], -sa * b[0, 0] + ca * b[0, 1], b[0, 2]])
     assert np.max(np.abs(q[0] - expected)) < 1e-20

@@ -7,6 +7,7 @@ from scipy.integrate import solve_ivp
 
 from pyins.reference import earth
 from pyins.sim import motion as M
+from pyins.sim import turntable as T
 
 D = earth.DEG_TO_RAD
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
@@ -206,9 +207,9 @@ def test_manoeuvre_rejects_bad_input():
 
 def test_table_profiles():
     t = np.array([0.0, 1.0, 100.0])
-    alpha, rate = M.Fixed(0.3).state(t)
+    alpha, rate = T.Fixed(0.3).state(t)
     assert np.all(alpha == 0.3) and np.all(rate == 0.0)
-    tab = M.ConstantRate(6 * D, 0.1)
+    tab = T.ConstantRate(6 * D, 0.1)
     alpha, rate = tab.state(t)
     assert np.all(rate == 6 * D)
     # angles equal alpha0 + rate t modulo whole turns

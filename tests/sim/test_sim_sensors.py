@@ -6,8 +6,8 @@ import pytest
 
 from pyins.reference import earth
 from pyins.sim import sensors as S
+from pyins.units import DT
 
-DT = 0.01
 
 
 def test_bias_only_mean_is_bias_dt():

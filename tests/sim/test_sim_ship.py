@@ -10,11 +10,12 @@ from pyins import fil, runner, sim
 from pyins.reference import earth
 from pyins.sim import imu
 from pyins.sim import motion as M
+from pyins.sim import turntable as T
 from pyins.sim import ship as S
+from pyins.units import DT
 
 D = earth.DEG_TO_RAD
 ARCSEC = earth.ARCSEC_TO_RAD
-DT = 0.01
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
 XIAN = (34.246 * D, 108.910 * D)      # seed 002's site, as tests/physics/test_error_free_nav.py
 
@@ -90,7 +91,7 @@ CASES = {
     "reference": dict(lever_b=LEVER_B, lever_p=(0, 0, 0), table=None, ref=True),
     "imu_lever_b": dict(lever_b=LEVER_B, lever_p=(0, 0, 0), table=None, ref=False),
     "imu_lever_p_table": dict(lever_b=LEVER_B, lever_p=LEVER_P,
-                              table=M.ConstantRate(6.0 * D, 0.4), ref=False),
+                              table=T.ConstantRate(6.0 * D, 0.4), ref=False),
 }
 
 
@@ -171,12 +172,12 @@ def test_nb_rate_and_derivative(base):
     mo = bad_sea() if base == "bad_sea" else M.HeadingSwing.experiment(2)
     t = np.linspace(1.0, 100.0, 1001)
     st = mo.state(t)
-    w, wd = S.nb_rate_and_derivative(st.euler, st.euler_rate, mo.euler_accel(t))
+    w, wd = imu.nb_rate_and_derivative(st.euler, st.euler_rate, mo.euler_accel(t))
     # Against C^T dC/dt: truncation h^4 / 30 x (1.9 rad/s)^5 x ~1 ~ 1e-12,
     # rounding 1e-16 / 1e-3; bound 1e-10 rad/s (a wrong sign is ~0.5 rad/s).
     assert np.max(np.abs(w - _omega_nb_fd(mo, t))) < 1e-10
     # w' against the differences of w: same size of errors, x 1.9; 1e-9 rad/s^2.
-    fd = central_diff(lambda s: S.nb_rate_and_derivative(
+    fd = central_diff(lambda s: imu.nb_rate_and_derivative(
         mo.state(s).euler, mo.state(s).euler_rate, mo.euler_accel(s))[0], t, 1e-3)
     assert np.max(np.abs(fd - wd)) < 1e-9
     # the same formula as body_rate_and_force: omega_ib - C_n^b omega_ie (ship
@@ -239,7 +240,7 @@ BASES = {
 @pytest.mark.parametrize("linear", [None, "empty"])
 def test_no_motion_no_lever_is_bit_identical_to_base(name, table, linear):
     base = BASES[name]()
-    tab = {None: None, "fixed": M.Fixed(0.7), "rate": M.ConstantRate(-6.0 * D, 0.2)}[table]
+    tab = {None: None, "fixed": T.Fixed(0.7), "rate": T.ConstantRate(-6.0 * D, 0.2)}[table]
     ship = S.ShipAtSea(base, None if linear is None else S.LinearMotion())
     a = imu.exact_increments(base, 3000, table=tab, start_tick=1234)
     b = imu.exact_increments(ship, 3000, table=tab, start_tick=1234)
@@ -270,7 +271,7 @@ def test_truth_reference_and_imu_point_differ_with_lever():
 
 def test_lever_p_uses_the_table_and_node_rates_refuse_it():
     sw = bad_sea()
-    table = M.ConstantRate(6.0 * D)
+    table = T.ConstantRate(6.0 * D)
     with_p = S.ShipAtSea(sw, None, lever_b=LEVER_B, lever_p=LEVER_P)
     without = S.ShipAtSea(sw, None, lever_b=LEVER_B)
     assert with_p.needs_table and not without.needs_table
@@ -288,7 +289,7 @@ def test_lever_p_uses_the_table_and_node_rates_refuse_it():
     np.testing.assert_allclose(fo.reshape(-1, 3), f2, rtol=0, atol=1e-14)
     np.testing.assert_allclose(om.reshape(-1, 3), o2, rtol=0, atol=1e-16)
     with pytest.raises(NotImplementedError, match="state3"):
-        M.TableMotion().state3(np.zeros(1))
+        T.TableMotion().state3(np.zeros(1))
 
 
 # --- end to end through the C++ firmware ---------------------------------------
@@ -356,7 +357,7 @@ def test_firmware_navigates_a_sensor_turning_on_the_table_1h():
     left out or wrong would give metres in an hour."""
     ship = S.ShipAtSea(M.Static(*XIAN, 0.0, 1 * D, -2 * D, 0.3), None, lever_b=(1.2, -1.2, 1.0),
                        lever_p=LEVER_P)
-    res, e, up = _errors_at_imu(ship, table=M.ConstantRate(6.0 * D))
+    res, e, up = _errors_at_imu(ship, table=T.ConstantRate(6.0 * D))
     print(f"\nturning offset 1 h: max horizontal {e.horizontal_m.max():.3e} m, "
           f"max |up| {np.abs(up).max():.3e} m")
     assert e.horizontal_m.max() < 1e-4
