@@ -3,11 +3,22 @@
 The firmware core is C++17/Eigen (``csrc/``), stepping at a fixed 100 Hz
 behind a plain C ABI (``csrc/include/pyins_core.h``). This package holds:
 
-- ``pyins.native``: the cffi binding of the built core (``Firmware``);
+- ``pyins.native``: the cffi binding of the built core (``Firmware``) and
+  of the compiled closed-loop plant (``Plant``);
 - ``pyins.reference``: the same algorithms written plainly in NumPy, module
   for module, which the C++ is tested against;
+- ``pyins.engine``: the choice between the two ("native", "reference");
 - ``pyins.sim``: the plant: ship motion, turntable, exact IMU increments,
-  sensor errors, IMU sample files.
+  sensor errors, IMU sample files;
+- ``pyins.units``: the unit constants and the tick, defined once;
+- ``pyins.scenario``: scenario files, checked and resolved to SI, and what a
+  run of one is built from (its initial state included);
+- ``pyins.runner`` (open loop) and ``pyins.fil`` (the closed loop through
+  the turntable) run the firmware against the truth; ``pyins.runs`` runs a
+  scenario into a run directory and replays logs; ``pyins.records`` holds
+  the record files and checkpoints; ``pyins.metrics`` every metric;
+  ``pyins.campaign`` and ``pyins.report`` sets of runs and their reports;
+  ``pyins.logs`` IMU log files; ``pyins.analysis`` error models.
 
 Conventions (shared by C++ and Python)
 --------------------------------------
@@ -24,8 +35,8 @@ clockwise from North in [0, 2 pi): heading = (-yaw) mod 2 pi. Every field says
 which of the two it is.
 
 Units: SI inside (rad, m, s, m/s); degrees, arc-seconds, deg/h, micro-g only
-at the edges, through the named conversions of ``pyins.reference.earth``.
-Time inside the firmware is an integer tick count.
+at the edges, through the named conversions of ``pyins.units``.
+Time inside the firmware is an integer tick count (``pyins.units.TICK_HZ``).
 
 Note: nmayorov's ``pyins`` (distributed as ``python-ins``) uses the same
 import name; the two cannot share one environment.

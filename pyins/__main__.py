@@ -25,30 +25,34 @@ import time
 
 import numpy as np
 
+from pyins import __version__, bench, campaign, engine, logs, native, report, runner, runs, scenario, sim
+from pyins.progress import TextProgress
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DT, NMI_TO_M, TICK_HZ
+
+_TICKS_PER_HOUR = 3600 * TICK_HZ
+
 
 def _demo(args):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from pyins import native, runner, sim
-    from pyins.reference import earth
-
     motion = sim.HeadingSwing.experiment(1)
     sensors = sim.SensorModel(sim.preset(args.sensors), seed=args.seed)
-    ticks = int(round(args.hours * 3600 * 100))
+    ticks = int(round(args.hours * _TICKS_PER_HOUR))
     t0 = time.perf_counter()
 
     def progress(done, total):
         if not args.quiet and sys.stdout.isatty():
-            print(f"\r  {done / 360000:6.2f} h of {total / 360000:.2f} h ship time", end="", flush=True)
+            print(f"\r  {done / _TICKS_PER_HOUR:6.2f} h of {total / _TICKS_PER_HOUR:.2f} h ship time", end="",
+                  flush=True)
 
     result = runner.navigate(motion, ticks, every=100, sensors=sensors, progress=progress)
     wall = time.perf_counter() - t0
     if not args.quiet and sys.stdout.isatty():
         print()
     e = runner.nav_errors(result)
-    arcsec, arcmin = earth.ARCSEC_TO_RAD, earth.ARCMIN_TO_RAD
+    arcsec, arcmin = ARCSEC_TO_RAD, ARCMIN_TO_RAD
     summary = {
         "scenario": "seed 002 experiment 1 heading swing, IMU fixed to the ship",
         "sensors": args.sensors,
@@ -56,7 +60,7 @@ def _demo(args):
         "wall_time_s": wall,
         "final_horizontal_error_m": float(e.horizontal_m[-1]),
         "max_horizontal_error_m": float(e.horizontal_m.max()),
-        "max_horizontal_error_nmi": float(e.horizontal_m.max() / earth.NMI_TO_M),
+        "max_horizontal_error_nmi": float(e.horizontal_m.max() / NMI_TO_M),
         "max_level_error_arcsec": float(np.abs(e.att_n_rad[:, :2]).max() / arcsec),
         "max_heading_error_arcmin": float(np.abs(e.att_n_rad[:, 2]).max() / arcmin),
         "max_velocity_error_mps": float(np.abs(e.vel_n_mps[:, :2]).max()),
@@ -107,13 +111,12 @@ def _say(args, text):
 
 
 def _progress(args):
-    from pyins import fil
     if getattr(args, "quiet", False) or getattr(args, "json", False):
         return None
 
     def make(label):
         print(f"  {label}", file=sys.stderr, flush=True)
-        return fil.TextProgress()
+        return TextProgress()
     return make
 
 
@@ -123,8 +126,6 @@ def _emit_json(args, obj):
 
 
 def _summary_lines(summary):
-    from pyins import runs
-    from pyins.reference import earth
     out = []
     for v in summary["variants"]:
         m = v["metrics"]
@@ -132,9 +133,9 @@ def _summary_lines(summary):
             out.append(f"  {v['label']}: no records")
             continue
         out.append(f"  {v['label']}: max horizontal {m['horizontal_error_max']:.1f} m "
-                   f"({m['horizontal_error_max'] / earth.NMI_TO_M:.3f} nmi), "
-                   f"final level {m['level_error_final'] / earth.ARCSEC_TO_RAD:.2f}\", "
-                   f"final heading {m['heading_error_final'] / earth.ARCMIN_TO_RAD:.3f}'"
+                   f"({m['horizontal_error_max'] / NMI_TO_M:.3f} nmi), "
+                   f"final level {m['level_error_final'] / ARCSEC_TO_RAD:.2f}\", "
+                   f"final heading {m['heading_error_final'] / ARCMIN_TO_RAD:.3f}'"
                    + ("" if v["complete"] else f"  [partial: {v['ticks_done']} of {v['ticks']} ticks]"))
     for r in runs.paper_rows(summary):
         ours = "-" if r["ours"] is None else f"{r['ours']:.4g}"
@@ -148,7 +149,6 @@ def _default_out(name):
 
 
 def cmd_run(args):
-    from pyins import report, runs, scenario
     scn = scenario.load(args.scenario)
     overrides = {}
     for item in args.set or []:
@@ -166,7 +166,7 @@ def cmd_run(args):
     _say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
     try:
         summary = runs.execute(scn, out, progress=_progress(args), resume=args.resume,
-                               log=None if args.quiet or args.json else print)
+                               log=None if args.quiet or args.json else print, engine=args.engine)
     except KeyboardInterrupt:
         report.render(out)
         print(f"pyins: interrupted; the partial result is in {out} (resume with --resume)", file=sys.stderr)
@@ -190,9 +190,6 @@ def _toml_value(text, where):
 
 
 def cmd_simulate(args):
-    import numpy as np
-
-    from pyins import logs, scenario, sim
     scn = scenario.load(args.scenario)
     if args.hours is not None:
         scn = scn.with_overrides({"duration": f"{args.hours} h"})
@@ -226,10 +223,6 @@ def cmd_simulate(args):
 
 
 def cmd_replay(args):
-    import numpy as np
-
-    from pyins import logs, native, runner, scenario, sim
-    from pyins.reference import earth
     read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
                    axes=args.axes, time_col=args.time_col)
     if args.table_angle is not None:
@@ -241,13 +234,11 @@ def cmd_replay(args):
     elif data.metadata.get("scenario"):
         scn = scenario.loads(data.metadata["scenario"], source=f"{args.log} (metadata)",
                              name=data.metadata.get("scenario_name"))
-    cfg, motion, spec = {}, None, None
+    cfg, spec = {}, None
     if scn is not None:
         specs = list(scn.runs())
         spec = specs[int(data.metadata.get("variant", 0)) if not args.scenario else 0]
-        motion = spec.motion
-        cfg = runner.initial_config(motion, None, **spec.config)
-        cfg["index_scheme"] = 0        # a log's table angles are recorded: no commands
+        cfg = runs.replay_config(spec)
     for name, val in (("lat_rad", args.lat), ("lon_rad", args.lon)):
         if val is not None:
             cfg[name] = np.radians(val)
@@ -256,35 +247,16 @@ def cmd_replay(args):
     if args.attitude is not None:
         cfg["euler_b_rad"] = np.radians(args.attitude)
     if args.coarse is not None:
-        cfg["coarse_ticks"] = int(round(args.coarse / (data.dt or 0.01)))
+        cfg["coarse_ticks"] = int(round(args.coarse / (data.dt or DT)))
     if args.fine is not None:
-        cfg["fine_ticks"] = int(round(args.fine / (data.dt or 0.01)))
+        cfg["fine_ticks"] = int(round(args.fine / (data.dt or DT)))
     if "lat_rad" not in cfg:
         raise InputError(f"{args.log}: no initial position: give --scenario or --lat/--lon/--height "
                          "(and --attitude, or --coarse to align)")
-    fw = native.Firmware(cfg)
-    samples = native.make_samples(np.ascontiguousarray(data.dtheta_p), np.ascontiguousarray(data.dv_p),
-                                  np.ascontiguousarray(data.table_angle_rad))
     out_dir = args.out or _default_out("replay")
-    os.makedirs(out_dir, exist_ok=True)
-    every = max(1, int(args.every))
-    recs = fw.run(samples, every=every)
-    np.savez(os.path.join(out_dir, "navigation.npz"), outputs=recs)
-    summary = dict(log=os.path.abspath(args.log), samples=int(len(samples)), every=every,
-                   final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
-                              lon_deg=float(np.degrees(recs["lon_rad"][-1])),
-                              euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
-                              mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
-    if motion is not None:
-        truth = sim.truth_at(motion, recs["tick"], dt=spec.dt)
-        e = runner.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=spec.dt))
-        summary["errors"] = dict(horizontal_max_m=float(e.horizontal_m.max()),
-                                 horizontal_final_m=float(e.horizontal_m[-1]),
-                                 heading_final_arcmin=float(e.att_n_rad[-1, 2] / earth.ARCMIN_TO_RAD),
-                                 level_max_arcsec=float(np.abs(e.att_n_rad[:, :2]).max() / earth.ARCSEC_TO_RAD))
-    with open(os.path.join(out_dir, "summary.json"), "w") as f:
-        json.dump(summary, f, indent=2)
-    _say(args, f"pyins replay {args.log}: {len(samples)} samples -> {out_dir}/navigation.npz")
+    summary = runs.replay(data, cfg, out_dir, every=args.every, spec=spec, engine=args.engine,
+                          log_path=args.log)
+    _say(args, f"pyins replay {args.log}: {summary['samples']} samples -> {out_dir}/navigation.npz")
     fin = summary["final"]
     _say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, mode {fin['mode']}, "
                f"faults {fin['fault_flags']}")
@@ -297,7 +269,6 @@ def cmd_replay(args):
 
 
 def cmd_report(args):
-    from pyins import report
     if not os.path.exists(os.path.join(args.rundir, "summary.json")):
         raise InputError(f"{args.rundir}: not a run directory (no summary.json)")
     path = report.render(args.rundir)
@@ -307,15 +278,9 @@ def cmd_report(args):
 
 
 def cmd_list(args):
-    from pyins import scenario, sim
     items = dict(scenarios=scenario.list_builtin(), sensor_presets=sorted(sim.PRESETS),
                  index_schemes=sorted(scenario.INDEX_SCHEMES))
-    try:
-        from pyins import campaign
-        items["campaigns"] = campaign.list_builtin()
-    except ImportError:
-        pass
-    from pyins import logs
+    items["campaigns"] = campaign.list_builtin()
     items["log_formats"] = list(logs.FORMATS)
     if args.json:
         _emit_json(args, items)
@@ -335,7 +300,6 @@ def cmd_list(args):
 
 
 def cmd_bench(args):
-    from pyins import bench
     fig = bench.run(seconds=args.seconds)
     if args.json:
         _emit_json(args, fig)
@@ -346,7 +310,6 @@ def cmd_bench(args):
 
 
 def cmd_campaign(args):
-    from pyins import campaign
     if args.campaign and (args.grid or args.scenario):
         raise InputError("campaign: give a campaign (NAME or FILE) or --scenario with --grid, not both")
     if args.campaign:
@@ -378,7 +341,8 @@ def cmd_campaign(args):
 EXAMPLES = {
     "run": "examples:\n  pyins run seed003\n  pyins run my_ship.toml --out runs/my_ship\n"
            "  pyins run seed002_exp1 --hours 6 --set indexing.stop=\"120 s\"\n"
-           "  pyins run seed002_exp1 --out runs/exp1 --resume   # continue after Ctrl-C or a kill",
+           "  pyins run seed002_exp1 --out runs/exp1 --resume   # continue after Ctrl-C or a kill\n"
+           "  pyins run seed003 --hours 0.02 --engine reference  # through the NumPy mirror",
     "simulate": "example:\n  pyins simulate demo imu.npz --hours 0.5\n  pyins simulate seed000_static imu.txt",
     "replay": "examples:\n  pyins replay imu.npz                       # initial state from the log's scenario\n"
               "  pyins replay field.txt --kind rates --gyro-unit deg/s --accel-unit g --axes frd \\\n"
@@ -414,6 +378,8 @@ def build_parser():
     p.add_argument("--seed", type=int, help="override the noise seed")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario key (repeatable)")
     p.add_argument("--resume", action="store_true", help="continue an interrupted run in --out")
+    p.add_argument("--engine", choices=engine.ENGINES, default="native",
+                   help="the firmware and plant: native (compiled, default) or reference (NumPy mirror)")
     p = cmd("simulate", "write the IMU log of a scenario (open loop, table fixed)")
     p.add_argument("scenario")
     p.add_argument("log", help="output file: .npz, .csv, .txt, .bin")
@@ -440,6 +406,8 @@ def build_parser():
     p.add_argument("--fine", type=float, help="fine alignment time [s]")
     p.add_argument("--every", type=int, default=100, help="record every N samples (default 100 = 1 s)")
     p.add_argument("--out", help="output directory (default runs/replay)")
+    p.add_argument("--engine", choices=engine.ENGINES, default="native",
+                   help="the firmware: native (compiled, default) or reference (NumPy mirror)")
     p = cmd("report", "(re)render the plots and report.html of a run directory")
     p.add_argument("rundir")
     p = cmd("campaign", "grids and Monte-Carlo sets on a local process pool or a Dask cluster")
@@ -474,14 +442,12 @@ def main(argv=None):
                     campaign=cmd_campaign, list=cmd_list, bench=cmd_bench)
     try:
         if args.command == "demo":
-            from pyins import sim
             if args.sensors not in sim.PRESETS:
                 ap.error(f"--sensors: unknown preset {args.sensors!r} (known: {', '.join(sim.PRESETS)})")
             if not args.hours > 0:
                 ap.error("--hours: must be positive")
             return _demo(args)
         if args.command == "version":
-            from pyins import __version__, native
             print(f"pyins {__version__}, core {native.version()} (ABI {'.'.join(map(str, native.abi_version()))})")
             return EXIT_OK
         return handlers[args.command](args)
@@ -491,7 +457,6 @@ def main(argv=None):
     except Exception as exc:   # one line for the user; --debug for the traceback
         if args.debug:
             raise
-        from pyins import native
         if isinstance(exc, native.CoreError):
             print(f"pyins {args.command}: firmware error: {exc}", file=sys.stderr)
             return EXIT_FAILED

@@ -65,7 +65,7 @@ def reduced_truth(limits, phi_true=np.zeros(3)):
 class StaticErrors:
     """Errors predicted by the linear model at the times asked for."""
     time_s: np.ndarray
-    att_n_rad: np.ndarray    #: phi (E, N, U), (N, 3), same sign as runner.NavErrors
+    att_n_rad: np.ndarray    #: phi (E, N, U), (N, 3), same sign as metrics.NavErrors
     vel_n_mps: np.ndarray    #: (N, 2) east, north
     north_m: np.ndarray
     east_m: np.ndarray
@@ -159,7 +159,7 @@ def table_projected(bias_p, euler_b, rec_time_s, rec_alpha_rad, alpha0=0.0):
     unwrapped; ``alpha0`` at t = 0): a function of time for
     ``static_error_model``.
 
-    C_p^n(t) = C_b^n Rz(alpha(t)) (DESIGN.md sec. 2); alpha is interpolated
+    C_p^n(t) = C_b^n Rz(alpha(t)) (docs/design.md §2); alpha is interpolated
     linearly between records, exact while the table turns at constant rate
     or stands still.
     """
@@ -195,10 +195,11 @@ def predict_static_fil(result, lat, euler_b, gyro_bias_p, accel_bias_p, times_s,
 
 def drift_surviving(yaw_p, mask=None):
     """The fraction of a constant x/y drift of the IMU that survives the
-    modulation (SPEC 1.10's proxy): |sum of [cos psi, sin psi]| / number of
-    samples, psi the IMU yaw sampled uniformly (e.g. an output record every
-    second). With ``mask`` only the masked samples are summed (still divided
-    by all of them), e.g. the stopped ones: the parts add up as vectors."""
+    modulation (the proxy of docs/papers.md, seed 002 §10): |sum of [cos psi,
+    sin psi]| / number of samples, psi the IMU yaw sampled uniformly (e.g.
+    an output record every second). With ``mask`` only the masked samples
+    are summed (still divided by all of them), e.g. the stopped ones: the
+    parts add up as vectors."""
     psi = np.asarray(yaw_p, dtype=float)
     sel = psi if mask is None else psi[np.asarray(mask, dtype=bool)]
     return float(np.hypot(np.cos(sel).sum(), np.sin(sel).sum()) / len(psi))

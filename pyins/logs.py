@@ -2,7 +2,7 @@
 of other INS tools, and the project's own .npz and CSV (`pyins.sim.io`).
 
 Every reader returns a `pyins.sim.io.ImuData` in the project's terms
-(DESIGN.md sections 2-3): one sample per tick, the angle increment
+(docs/design.md §2-§3): one sample per tick, the angle increment
 ``dtheta_p`` [rad] and the velocity increment ``dv_p`` [m/s] over the tick
 ``[t_{k-1}, t_k]`` in the IMU frame p (x right, y forward, z up), and the table
 angle at ``t_k`` [rad]. docs/log-formats.md has the same content with examples.

@@ -1,4 +1,5 @@
-"""cffi (ABI mode) binding of the built firmware core.
+"""cffi (ABI mode) binding of the built firmware core (`Firmware`) and of the
+compiled closed-loop plant (`Plant`, ``libpyins_plant.so``).
 
 The library ``libpyins_core.so`` and its headers are installed inside the
 ``pyins`` package by ``pip install .``; the cdef is read from the installed
@@ -421,6 +422,89 @@ class Firmware:
                 raise SampleError(status, int(n_done[0]), outputs[: n_done[0]].copy())
             raise CoreError(status, "pyins_run")
         return outputs
+
+
+class PlantError(CoreError):
+    """``pyins_fil_run`` stopped at a rejected sample: ``outputs`` and
+    ``records`` are the kept records before it, ``n_done`` the ticks done."""
+
+    def __init__(self, code, where, n_done, outputs, records):
+        self.n_done, self.outputs, self.records = n_done, outputs, records
+        super().__init__(code, where)
+
+
+class Plant:
+    """The compiled plant (``libpyins_plant.so``, csrc/plant): the turntable's
+    motor and encoder and the IMU's sensor errors around one `Firmware`,
+    tick by tick (``pyins_fil_run``).
+
+    ``table`` holds the pyins_table_config fields (a
+    ``pyins.sim.turntable.TableConfig``), ``errors`` the plant's error
+    matrices (``pyins.sim.turntable.error_matrices``), ``alpha0`` the table
+    angle at the start [rad]. ``record_dtype`` is the NumPy twin of
+    ``pyins_plant_record``, given by the caller (pyins.records).
+    """
+
+    def __init__(self, table, errors, record_dtype, alpha0=0.0):
+        if plant is None:
+            raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
+        self._st = ffi.new("pyins_plant_state *")
+        self._st.alpha_rad = alpha0
+        self._err = ffi.new("pyins_imu_errors *")
+        for i in range(9):
+            self._err.gyro_m[i] = errors["gyro_m"].ravel()[i]
+            self._err.accel_m[i] = errors["accel_m"].ravel()[i]
+        for i in range(3):
+            self._err.gyro_bias_rad_s[i] = errors["gyro_bias"][i]
+            self._err.accel_bias_mps2[i] = errors["accel_bias"][i]
+        self._err.gyro_quantum_rad = errors["gyro_quantum"]
+        self._err.accel_quantum_mps = errors["accel_quantum"]
+        self._tab = ffi.new("pyins_table_config *")
+        t = self._tab
+        t.rate_max_rad_s, t.accel_max_rad_s2 = table.rate_max_rad_s, table.accel_max_rad_s2
+        t.encoder_lsb_rad, t.jump_rad = table.encoder_lsb_rad, table.jump_rad
+        t.fault_tick, t.fault = table.fault_tick, table.fault
+        self._record_dtype = record_dtype
+        self._n_done = ffi.new("size_t *")
+        self._n_out = ffi.new("size_t *")
+
+    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every):
+        """``n`` ticks of the closed loop around ``fw`` (a `Firmware`).
+
+        omega, force: the ship's body rate and specific force at the
+        quadrature nodes (x, w) of ``period`` ticks, starting at phase
+        ``phase0`` (tiled when the motion repeats); gyro_noise, accel_noise:
+        (n, 3) white-noise increments or None. Returns (outputs, records) at
+        the ticks that are multiples of ``every``; PlantError at a rejected
+        sample.
+        """
+        omega, force = np.ascontiguousarray(omega), np.ascontiguousarray(force)
+        x, w = np.ascontiguousarray(x), np.ascontiguousarray(w)
+        g_ptr = ffi.NULL if gyro_noise is None else ffi.from_buffer("double[]", gyro_noise)
+        a_ptr = ffi.NULL if accel_noise is None else ffi.from_buffer("double[]", accel_noise)
+        cap = n // every + 1
+        out = np.empty(cap, dtype=OUTPUT_DTYPE)
+        rec = np.empty(cap, dtype=self._record_dtype)
+        tick0 = self._st.tick
+        status = plant.pyins_fil_run(
+            fw.core, self._st, self._tab, self._err, ffi.from_buffer("double[]", omega),
+            ffi.from_buffer("double[]", force), ffi.from_buffer("double[]", x),
+            ffi.from_buffer("double[]", w), len(x), period, phase0, g_ptr, a_ptr, n, dt, every,
+            ffi.from_buffer("pyins_output[]", out, require_writable=True),
+            ffi.cast("pyins_plant_record *", ffi.from_buffer(rec, require_writable=True)), cap,
+            self._n_done, self._n_out)
+        kept = self._n_out[0]
+        if status != 0:
+            raise PlantError(status, f"pyins_fil_run at tick {tick0 + self._n_done[0]}",
+                             int(self._n_done[0]), out[:kept].copy(), rec[:kept].copy())
+        return out[:kept], rec[:kept]
+
+    def snapshot(self):
+        """The plant state as raw bytes (restore on the machine kind that wrote it)."""
+        return bytes(ffi.buffer(self._st, ffi.sizeof("pyins_plant_state")))
+
+    def restore(self, blob):
+        ffi.memmove(self._st, blob, ffi.sizeof("pyins_plant_state"))
 
 
 def abi_version():

@@ -20,11 +20,11 @@ from pathlib import Path
 import numpy as np
 
 from pyins import native, sim
-from pyins.reference import earth
 from pyins.reference import firmware as ref_firmware
+from pyins.units import DEG_TO_RAD
 
 ROOT = Path(__file__).resolve().parent.parent
-LAT = 34.246 * earth.DEG_TO_RAD
+LAT = 34.246 * DEG_TO_RAD
 MODES = {
     "coarse": dict(coarse_ticks=25500),
     "fine5": dict(fine_ticks=10**6, fine_states=5),

@@ -23,6 +23,7 @@ import numpy as np
 from pyins import fil, native, runner, sim
 from pyins.reference import firmware as ref_firmware
 from pyins.sim import turntable
+from pyins.units import DT, TICK_HZ
 
 
 def main(argv=None):
@@ -49,17 +50,17 @@ def main(argv=None):
     fw.run(samples)
     t_fw = time.perf_counter() - t0
     # the NumPy loop
-    k = int(args.ref_seconds * 100)
+    k = int(args.ref_seconds * TICK_HZ)
     ref = ref_firmware.Firmware(runner.initial_config(m, None, **cfg))
     st, tab, mats = turntable.PlantState(), turntable.TableConfig(), turntable.error_matrices(errors)
     omega, force, x, w = sim.node_rates(m, np.arange(k))
-    z = np.random.default_rng(1).standard_normal((k, 6)) * np.sqrt(0.01)
+    z = np.random.default_rng(1).standard_normal((k, 6)) * np.sqrt(DT)
     t0 = time.perf_counter()
     t_plant_ref = 0.0
     for i in range(k):
         tp = time.perf_counter()
         g, a, enc, seq = turntable.plant_tick(tab, st, mats, omega[i], force[i], x, w,
-                                              errors.gyro_arw * z[i, :3], errors.accel_vrw * z[i, 3:], 0.01)
+                                              errors.gyro_arw * z[i, :3], errors.accel_vrw * z[i, 3:], DT)
         t_plant_ref += time.perf_counter() - tp
         _, r = ref.step(g, a, enc, seq)
         st.rate_cmd_rad_s = r["motor_rate_cmd_rad_s"]
@@ -86,7 +87,7 @@ def main(argv=None):
     print(f"{'NumPy firmware alone':34s} {fig['firmware_numpy_ticks_per_s']:12,.0f}")
     print(f"ratio C++ / NumPy closed loop: {fig['ratio_cpp_vs_numpy_fil']:,.0f}x")
 
-    ticks = int(round(args.hours * 360_000))
+    ticks = int(round(args.hours * 3600 * TICK_HZ))
     t0 = time.perf_counter()
     res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=1, every=100)
     wall = time.perf_counter() - t0

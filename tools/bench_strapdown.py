@@ -22,11 +22,11 @@ from pathlib import Path
 import numpy as np
 
 from pyins import native, sim
-from pyins.reference import earth
 from pyins.reference import firmware as ref_firmware
+from pyins.units import DEG_TO_RAD, TICK_HZ
 
 ROOT = Path(__file__).resolve().parent.parent
-LAT = 34.246 * earth.DEG_TO_RAD
+LAT = 34.246 * DEG_TO_RAD
 
 
 def best_of(fn, repeat):
@@ -68,7 +68,7 @@ def main(argv=None):
                     help="ship time the NumPy reference is timed on")
     args = ap.parse_args(argv)
 
-    n = int(round(args.hours * 3600 * 100))
+    n = int(round(args.hours * 3600 * TICK_HZ))
     motion = sim.sea_state("bad", LAT, 0.0, 0.0, yaw0=0.3)
     dtheta, dv, table = sim.exact_increments(motion, n)
     samples = native.make_samples(dtheta, dv, table)
@@ -110,7 +110,7 @@ def main(argv=None):
     t_wrap1 = best_of(lambda: [fw.run(one, one_out) for _ in range(k2)], 3) / k2
 
     # 4. NumPy reference, per step
-    n_ref = int(args.ref_seconds * 100)
+    n_ref = int(args.ref_seconds * TICK_HZ)
     ref = ref_firmware.Firmware(cfg)
     t_ref = best_of(lambda: ref.run(dtheta[:n_ref], dv[:n_ref], table[:n_ref]), 1) * n / n_ref
 

@@ -6,7 +6,7 @@
  * an instance needs, pyins_init() builds it there, and the core never
  * allocates, throws, prints or keeps global state.
  *
- * Frames and units (DESIGN.md section 2): n = East-North-Up, b = ship body
+ * Frames and units (docs/design.md §2): n = East-North-Up, b = ship body
  * (x starboard, y bow, z up), p = IMU frame on the turntable, C_p^b = Rz(alpha).
  * SI units: rad, m, s, m/s. Euler angles [pitch, roll, yaw], C_b^n =
  * Rz(yaw) Rx(pitch) Ry(roll), yaw counter-clockwise from North; heading is the
@@ -98,7 +98,7 @@ enum pyins_index_scheme {
     PYINS_INDEX_FLEXIBLE_TWO = 4,     /* seed 002 flexible: flex-cos fwd, +180, flex-sin rev, -180 */
     PYINS_INDEX_CUSTOM = 5,           /* index_steps[0 .. index_n_steps-1] */
     PYINS_INDEX_FLEXIBLE_DERIVED = 6  /* seed 002's three-stop derivation: flex-cos fwd, flex-sin rev,
-                                         without the fixed 180-deg moves (SPEC 1.6 note 3) */
+                                         without the fixed 180-deg moves (docs/papers.md, seed 002 §6, note 3) */
 };
 
 /* Which ticks add cos psi, sin psi to A_c, A_s (pyins_config.index_sums). */

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "angle.hpp"
+
 namespace {
 
 constexpr int kMaxNodes = 16;
@@ -47,15 +49,6 @@ void apply_errors(const double m[9], const double bias[3], double quantum, const
         }
         out[i] = v;
     }
-}
-
-double wrap_two_pi(double a) {
-    constexpr double kTwoPi = 6.283185307179586476925286766559;
-    double w = a - kTwoPi * std::floor(a / kTwoPi);
-    if (w >= kTwoPi) {
-        w = 0.0;
-    }
-    return w;
 }
 
 }  // namespace
@@ -127,7 +120,7 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
         if (table->fault == PYINS_TABLE_JUMP && st->tick > table->fault_tick) {
             enc = enc + table->jump_rad;
         }
-        enc = wrap_two_pi(enc);
+        enc = pyins::angle::wrap_two_pi(enc);
         if (table->encoder_lsb_rad > 0.0) {
             enc = table->encoder_lsb_rad * std::floor(enc / table->encoder_lsb_rad);
         }

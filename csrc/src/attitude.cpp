@@ -3,13 +3,10 @@
 
 #include <cmath>
 
-#include "earth.hpp"
 #include "math_portable.hpp"
+#include "units.hpp"
 
 namespace pyins::attitude {
-
-using earth::kPi;
-using earth::kTwoPi;
 
 Mat3 skew(const Vec3& v) {
     Mat3 m;

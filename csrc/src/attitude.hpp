@@ -1,7 +1,7 @@
 // attitude.hpp: quaternions, DCMs, Euler angles, rotation vectors.
 //
 // Mirrored by pyins/reference/attitude.py (same names, same operation order).
-// Conventions (DESIGN.md 2): Hamilton quaternions [w, x, y, z]; quat_nb and
+// Conventions (docs/design.md §2): Hamilton quaternions [w, x, y, z]; quat_nb and
 // mat_nb map b to n; Euler [pitch, roll, yaw] with C_b^n = Rz(yaw) Rx(pitch)
 // Ry(roll); yaw counter-clockwise from North; heading = (-yaw) mod 2 pi.
 //

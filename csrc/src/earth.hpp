@@ -1,13 +1,14 @@
 // earth.hpp: WGS-84 Earth model for the navigation frame n = East-North-Up.
 //
 // Mirrored line for line by pyins/reference/earth.py. The simulator uses the
-// reference module, so plant and firmware share one Earth model (DESIGN.md 4).
+// reference module, so plant and firmware share one Earth model (docs/design.md §4).
 //
 // References: NIMA TR8350.2 (2000) eqs. 4-1, 4-3 (normal gravity);
 // Qin Yongyuan, "Inertial Navigation" (2014) sec. 4.1 (radii, rates).
 #pragma once
 
 #include "types.hpp"
+#include "units.hpp"
 
 namespace pyins::earth {
 
@@ -21,11 +22,6 @@ inline constexpr double kGM = 3.986004418e14;            ///< gravitational cons
 inline constexpr double kGammaE = 9.7803253359;          ///< normal gravity, equator [m/s^2]
 inline constexpr double kSomigliana = 0.00193185265241;  ///< Somigliana k [-]
 inline constexpr double kMGrav = kOmegaIe * kOmegaIe * kA * kA * kB / kGM;  ///< m [-]
-
-// --- named unit conversions (earth.py: DEG_TO_RAD, ...) -------------------
-inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kTwoPi = 2.0 * kPi;
-inline constexpr double kDegToRad = kPi / 180.0;
 
 /// Meridian (R_M) and prime-vertical (R_N) radii of curvature [m].
 struct PrincipalRadii {

@@ -1,8 +1,9 @@
-// firmware.hpp: the firmware instance: configuration, mode, one step.
+// firmware.hpp: the firmware instance: mode, one step per sample.
 //
-// Mirrored by pyins/reference/firmware.py. In this first form the firmware
-// navigates from the configured initial state (mode NAVIGATE); alignment
-// and indexing extend the same instance.
+// Mirrored by pyins/reference/firmware.py. The instance takes a checked
+// configuration (config.hpp) and resolves it; each sample is checked
+// (finite, not saturated, in sequence), then advances one tick through the
+// mode machine: coarse alignment, fine alignment, navigation with indexing.
 #pragma once
 
 #include <cstddef>
@@ -15,90 +16,25 @@
 #include "moving_align.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
+#include "units.hpp"
 
 namespace pyins::firmware {
 
 /// Firmware modes, as reported in pyins_output.mode (enum pyins_mode).
-enum class Mode : int32_t { kIdle = 0, kCoarseAlign = 1, kFineAlign = 2, kNavigate = 3 };
+enum class Mode : int32_t {
+    kIdle = PYINS_MODE_IDLE,
+    kCoarseAlign = PYINS_MODE_COARSE_ALIGN,
+    kFineAlign = PYINS_MODE_FINE_ALIGN,
+    kNavigate = PYINS_MODE_NAVIGATE
+};
 
-inline constexpr int32_t kDefaultTickHz = 100;
-inline constexpr int32_t kMaxTickHz = 10000;
-/// The ENU frame is singular at the poles: latitudes beyond this are refused.
-inline constexpr double kMaxLatRad = 89.9 * 3.14159265358979323846 / 180.0;
-/// Coarse alignment defaults, in seconds (seed 000: first output 20 s, then 1 s).
-inline constexpr int32_t kDefaultCoarseFirstS = 20;
-inline constexpr int32_t kDefaultCoarseEveryS = 1;
-inline constexpr double kDefaultCoarseRatio = 0.5;
-/// Fine alignment defaults (seed 001 sec. 3.3; SPEC.md).
-inline constexpr int32_t kDefaultFineStates = 5;
-inline constexpr int32_t kDefaultFineMeasEvery = 10;             ///< 10 Hz updates at 100 Hz
-inline constexpr int32_t kDefaultMovingMeasEverySecond = 1;      ///< moving base: 1 Hz position updates
-inline constexpr double kDefaultPosSigma = 0.5;                  ///< [m]: a moored ship's surge and sway
-inline constexpr double kDefaultSigma0Vel = 0.5;                 ///< [m/s]: its wave velocity at the start
-inline constexpr double kDefaultFineArw = 0.001 * (3.14159265358979323846 / 180.0) / 60.0;  ///< 0.001 deg/sqrt(h)
-inline constexpr double kDefaultFineVrw = 10.0e-6 * 9.80665;   ///< 10 ug/sqrt(Hz)
-inline constexpr double kArcminRad = 3.14159265358979323846 / 180.0 / 60.0;
-inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminRad, 100.0 * kArcminRad,
-                                                   600.0 * kArcminRad};  ///< 10 x [10', 10', 60']
-/// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
-/// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
-/// tools/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
-/// heading let the wave noise swing the early heading by 80' (measured).
-inline constexpr double kDefaultMovingSigmaAtt[3] = {1.0 * kArcminRad, 1.0 * kArcminRad,
-                                                     10.0 * kArcminRad};
-inline constexpr double kDefaultFineSigmaGyro = 0.01 * (3.14159265358979323846 / 180.0) / 3600.0;
-inline constexpr double kDefaultFineSigmaAccel = 100.0e-6 * 9.80665;  ///< 100 ug (not in seed 001)
-/// Indexing defaults (seeds 002, 003: 6 deg/s; stops 60 s in seed 003, 300 s in seed 002).
-inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
-inline constexpr double kDefaultIndexRate = 6.0 * kDeg;
-inline constexpr double kDefaultIndexAccel = 30.0 * kDeg;     ///< not in the papers
-inline constexpr double kDefaultIndexDelta = 0.01;            ///< seed 002, at 100 Hz
-inline constexpr double kDefaultIndexMaxFlex = 720.0 * kDeg;  ///< two turns: the ship may turn back
-inline constexpr double kDefaultIndexTolerance = 0.5 * kDeg;
-inline constexpr double kDefaultIndexJump = 5.0 * kDeg;
-inline constexpr int32_t kDefaultIndexTimeoutS = 2;
-inline constexpr int32_t kDefaultStopSeed003S = 60;
-inline constexpr int32_t kDefaultStopS = 300;
-/// Sample-level faults (docs/core.md). Saturation defaults: 400 deg/s and
-/// 20 g per axis, the order of a navigation-grade RLG IMU's range (the
-/// issue's figures); a ship stays far below (seed 000's bad sea state peaks
-/// at 23 deg/s and 0.3 g beyond gravity), so only a saturated sensor (a
-/// shock) or a corrupted word reaches them.
-inline constexpr double kDefaultSatGyroRate = 400.0 * kDeg;      ///< [rad/s]
-inline constexpr double kDefaultSatAccel = 20.0 * 9.80665;       ///< [m/s^2]
-/// Longest gap bridged by interpolation [ticks]; see docs/core.md for the
-/// error it leaves on seed 000's bad sea state.
-inline constexpr int32_t kDefaultSeqMaxGap = 2;
-/// Upper bound of seq_max_gap_ticks: one step call bridges at most this many
-/// ticks (its worst-case run time is that many strapdown updates).
-inline constexpr int32_t kMaxSeqGap = 100;
-/// Longest lever arm accepted [m]: a ship's IMU is metres from its reference
-/// point; beyond 100 m the number is a unit mistake (mm or inches).
-inline constexpr double kMaxLeverM = 100.0;
-/// Integrity defaults (docs/concepts.md, "Integrity"): 100 updates (10 s at
-/// 10 Hz) per NIS window and a bound of 4 on its mean (10 sigma of a
-/// consistent window); the coarse solution may wander 30' over its last
-/// fifth (measured on the moored ship with seed 000's errors: FIT over 120 s
-/// wanders 2.7-10.9', over 300 s < 1.5'; TRIAD over 300 s 164-326').
-inline constexpr int32_t kDefaultNisWindow = 100;
 /// A fine-alignment attitude is valid only once the filter's own heading
 /// sigma is within 10' (the bound the integrity acceptance uses): on PSINS's
 /// real laser-gyro log seed 001's 600' prior let the static filter wander
 /// 45' from its final heading while its sigma was still 440' (measured).
-inline constexpr double kValidHeadingSigma = 10.0 * kArcminRad;
-inline constexpr double kDefaultNisMax = 4.0;
-inline constexpr double kDefaultCoarseWander = 30.0 * kArcminRad;
+inline constexpr double kValidHeadingSigma = 10.0 * kArcminToRad;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
-
-/// Fill *cfg with the defaults (equal to a zeroed config).
-void config_default(pyins_config* cfg);
-
-/// PYINS_OK or the first PYINS_E_CONFIG_* that applies.
-int config_check(const pyins_config& cfg);
-
-/// The configuration with every zero-means-default field resolved.
-pyins_config config_resolved(const pyins_config& cfg);
 
 /// Sample-level fault counters (pyins_output.n_*), saturating at 2^32 - 1.
 struct SampleCounts {
@@ -175,7 +111,7 @@ class Firmware {
     void hold_at_site();
     /// Enter NAVIGATE: the indexing cycle starts from the measured angle.
     void start_navigation();
-    /// IMU yaw psi_p = psi_b + alpha (DESIGN.md) from the current solution.
+    /// IMU yaw psi_p = psi_b + alpha (docs/design.md §2) from the current solution.
     double imu_yaw() const;
     /// Lever arm (docs/concepts.md, "Lever arms"): rate estimates at the end
     /// of this tick from its increments and the last tick's.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "math_portable.hpp"
+#include "units.hpp"
 
 namespace pyins::indexing {
 
@@ -92,7 +93,6 @@ bool advance_command(Indexer& ix) {
 }  // namespace
 
 int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps) {
-    constexpr double kPi = 3.14159265358979323846;
     const Kind fx = Kind::kFixed;
     switch (scheme) {
         case 0:  // none: the IMU stays fixed to the ship

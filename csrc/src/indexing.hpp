@@ -10,13 +10,14 @@
 //   kFlexSin: seed 002 step 3: ... |sin psi + A_s/N_p| < delta and
 //             cos psi * A_c <= 0.
 // psi is the IMU yaw psi_p = psi_b + alpha from the firmware's own solution
-// (counter-clockwise, DESIGN.md); A_c, A_s accumulate cos psi, sin psi on
-// every tick the table is stopped, are frozen while it turns and are never
-// reset (seed 002, sec. 2); N_p is the stop's length in ticks (SPEC 1.6
-// reading (b)). With `sums` = 1 (PYINS_INDEX_SUMS_ALL, our extension) they
-// also accumulate while the table turns: the drift integrated over the turns
-// (about 9 % of the time at 300-s stops) is then cancelled by the flexible
-// stops too, which seed 002's rule leaves uncontrolled (docs/indexing.md).
+// (counter-clockwise, docs/design.md §2); A_c, A_s accumulate cos psi,
+// sin psi on every tick the table is stopped, are frozen while it turns and
+// are never reset (seed 002, sec. 2); N_p is the stop's length in ticks
+// (docs/papers.md, seed 002 §6, reading (b)). With `sums` = 1
+// (PYINS_INDEX_SUMS_ALL, our extension) they also accumulate while the
+// table turns: the drift integrated over the turns (about 9 % of the time at
+// 300-s stops) is then cancelled by the flexible stops too, which seed 002's
+// rule leaves uncontrolled (docs/indexing.md).
 //
 // Choices the paper leaves open (docs/indexing.md):
 // - "opposite sign" takes zero as either sign (sin psi * A_s <= 0);

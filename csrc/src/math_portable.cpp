@@ -10,6 +10,8 @@
 #include <cstring>
 #include <limits>
 
+#include "units.hpp"
+
 static_assert(std::numeric_limits<double>::is_iec559,
               "pmath needs IEEE-754 binary64 double");
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
@@ -114,8 +116,9 @@ constexpr double kPio2_3t = 0x1.b839a252049c1p-104;  // 8.47842766036889956997e-
 constexpr double kPio2_1t = 0x1.0b4611a626331p-34;   // 6.07710050650619224932e-11
 constexpr double kInvPio2 = 0x1.45f306dc9c883p-1;    // 2/pi, 6.36619772367581382433e-01
 
-// Correctly rounded multiples of pi, and the rounding error of pi.
-constexpr double kPi = 0x1.921fb54442d18p+1;     // 3.14159265358979311600e+00
+// Correctly rounded multiples of pi, and the rounding error of pi (kPi is
+// units.hpp's, the double nearest pi).
+static_assert(kPi == 0x1.921fb54442d18p+1, "kPi: 3.14159265358979311600e+00");
 constexpr double kPiLo = 0x1.1a62633145c07p-53;  // pi - kPi = 1.22464679914735317723e-16
 constexpr double kPio2 = 0x1.921fb54442d18p+0;   // 1.57079632679489655800e+00
 constexpr double kPio4 = 0x1.921fb54442d18p-1;   // 7.85398163397448278999e-01

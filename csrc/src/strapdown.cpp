@@ -4,6 +4,7 @@
 #include "attitude.hpp"
 #include "earth.hpp"
 #include "math_portable.hpp"
+#include "units.hpp"
 
 namespace pyins::strapdown {
 
@@ -88,10 +89,10 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     const Vec3 pos_rate = earth::position_rate(e, vel_avg);
     s.nav.lat = s.nav.lat + pos_rate(0) * dt;
     double lon = s.nav.lon + pos_rate(1) * dt;
-    if (lon > earth::kPi) {
-        lon = lon - earth::kTwoPi;
-    } else if (lon <= -earth::kPi) {
-        lon = lon + earth::kTwoPi;
+    if (lon > kPi) {
+        lon = lon - kTwoPi;
+    } else if (lon <= -kPi) {
+        lon = lon + kTwoPi;
     }
     s.nav.lon = lon;
     if (s.vertical == Vertical::kHold) {

@@ -5,6 +5,8 @@
 // scalar path (EIGEN_DONT_VECTORIZE) so the bits equal the Cortex-M build's.
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 
 namespace pyins {
@@ -20,5 +22,10 @@ struct Quat {
     double y;
     double z;
 };
+
+/// All three components of a C array (a pyins_config or pyins_sample field) finite.
+inline bool finite3(const double v[3]) {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
 
 }  // namespace pyins

@@ -2,8 +2,8 @@
 
 Mirrors ``csrc/src/attitude.{hpp,cpp}``, same names, same order of operations.
 
-Conventions (DESIGN.md section 2)
----------------------------------
+Conventions (docs/design.md §2)
+-------------------------------
 - Quaternions are Hamilton, scalar first, ``[w, x, y, z]``. ``quat_nb`` rotates
   a vector from b to n: ``v_n = quat_nb (x) v_b (x) conj(quat_nb)``.
 - ``mat_nb`` is C_b^n (columns are the b axes expressed in n).
@@ -151,7 +151,7 @@ def rotvec_to_mat(v):
 def rot_z(angle):
     """Rz(angle): rotation by angle about z, counter-clockwise seen from +z.
 
-    C_p^b = rot_z(alpha) for the turntable angle alpha (DESIGN.md section 2).
+    C_p^b = rot_z(alpha) for the turntable angle alpha (docs/design.md §2).
     """
     c = np.cos(angle)
     s = np.sin(angle)

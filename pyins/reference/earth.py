@@ -3,7 +3,7 @@
 Mirrors ``csrc/src/earth.{hpp,cpp}`` function for function, with the same names
 and the same order of operations, so the two can be read side by side. The
 simulator (``pyins.sim``) uses this same module, so an error-free simulation
-shows only algorithm error (DESIGN.md section 4).
+shows only algorithm error (docs/design.md §4).
 
 Navigation frame n is East-North-Up. All quantities SI: rad, m, s, m/s.
 

@@ -9,6 +9,15 @@ import numpy as np
 
 from . import earth, kalman
 
+# The state layouts (csrc/src/fine_align.hpp; seed 001 eqs. 11 and 21-24),
+# which the output record's kf_x and kf_sigma hold in this order:
+#   8-state X = [phi_E phi_N phi_U eps_E eps_N eps_U nabla_E nabla_N]
+#   5-state X = [phi_E^ phi_N^ phi_U^ eps_N^ eps_U^]
+PHI = slice(0, 3)        #: phi (both filters; the 5-state's transformed phi^)
+EPS = slice(3, 6)        #: eps_E, eps_N, eps_U (8-state)
+NABLA = slice(6, 8)      #: nabla_E, nabla_N (8-state)
+EPS_NU = slice(3, 5)     #: eps_N^, eps_U^ (5-state)
+
 
 @dataclass
 class Params:

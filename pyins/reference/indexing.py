@@ -1,11 +1,18 @@
-"""The indexing-motor state machine. Mirrors ``csrc/src/indexing.{hpp,cpp}``
-(the header documents the schemes-as-data design and every choice)."""
+"""The indexing-motor state machine.
+
+Mirrors ``csrc/src/indexing.{hpp,cpp}`` function by function, in the same
+order (the header documents the schemes-as-data design and every choice):
+the state changes (``_start_stop``, ``_start_move``, ``_enter_fault``), the
+command checks (``_off_command``, ``_flex_condition``), one tick of the
+command (``_advance_command``), then the interface: ``preset_steps``,
+``init``, ``reset``, ``update``. ``run`` mirrors the test hook.
+"""
 from dataclasses import dataclass, field
 
 import numpy as np
 
-SUMS_STOPS = 0       #: PYINS_INDEX_SUMS_STOPS: A_c, A_s over stopped ticks (seed 002)
-SUMS_ALL = 1         #: PYINS_INDEX_SUMS_ALL: over every tick, turns included (our extension)
+SUMS_STOPS = 0       #: kSumsStops (PYINS_INDEX_SUMS_STOPS): A_c, A_s over stopped ticks (seed 002)
+SUMS_ALL = 1         #: kSumsAll (PYINS_INDEX_SUMS_ALL): over every tick, turns included (our extension)
 
 KIND_FIXED = 1       #: Kind::kFixed
 KIND_FLEX_COS = 2    #: Kind::kFlexCos
@@ -16,10 +23,10 @@ STATE_STOP = 1       #: State::kStop
 STATE_MOVE = 2       #: State::kMove
 STATE_FAULT = 3      #: State::kFault
 
-FAULT_NONE = 0
-FAULT_LAG = 1
-FAULT_JUMP = 2
-FAULT_DRIFT = 3
+FAULT_NONE = 0       #: Fault::kNone
+FAULT_LAG = 1        #: Fault::kLag
+FAULT_JUMP = 2       #: Fault::kJump
+FAULT_DRIFT = 3      #: Fault::kDrift
 
 MAX_STEPS = 8        #: kMaxSteps
 
@@ -66,35 +73,6 @@ class Indexer:
     move_start: float = 0.0
     prev_meas: float = 0.0
     target_known: bool = True
-
-
-def preset_steps(scheme, stop_ticks):
-    """Steps of a preset scheme (mirrors ``indexing::preset_steps``); None if unknown."""
-    fx = KIND_FIXED
-    pi = np.pi
-    table = {
-        0: [],
-        1: [(fx, 2.0 * pi), (fx, -2.0 * pi)],
-        2: [(fx, pi), (fx, pi), (fx, -pi), (fx, -pi)],
-        3: [(fx, pi), (fx, -0.5 * pi), (fx, pi), (fx, -1.5 * pi)],
-        4: [(KIND_FLEX_COS, 1.0), (fx, pi), (KIND_FLEX_SIN, -1.0), (fx, -pi)],
-        6: [(KIND_FLEX_COS, 1.0), (KIND_FLEX_SIN, -1.0)],
-    }
-    if scheme not in table:
-        return None
-    return [Step(stop_ticks, kind, angle) for kind, angle in table[scheme]]
-
-
-def run(prm, meas0, meas, yaw_b):
-    """Mirror of the test hook pyins_t_indexing_run: per-tick records."""
-    ix = init(prm, meas0)
-    out = []
-    for k in range(len(yaw_b)):
-        m = meas[k] if meas is not None else ix.cmd_angle
-        update(ix, m, yaw_b[k] + m)
-        out.append((ix.state, ix.step, ix.fault, ix.fallbacks, ix.cmd_angle, ix.cmd_rate,
-                    ix.a_c, ix.a_s))
-    return out
 
 
 def _sense(angle):
@@ -166,6 +144,23 @@ def _advance_command(ix):
     return False
 
 
+def preset_steps(scheme, stop_ticks):
+    """Steps of a preset scheme (mirrors ``indexing::preset_steps``); None if unknown."""
+    fx = KIND_FIXED
+    pi = np.pi
+    table = {
+        0: [],
+        1: [(fx, 2.0 * pi), (fx, -2.0 * pi)],
+        2: [(fx, pi), (fx, pi), (fx, -pi), (fx, -pi)],
+        3: [(fx, pi), (fx, -0.5 * pi), (fx, pi), (fx, -1.5 * pi)],
+        4: [(KIND_FLEX_COS, 1.0), (fx, pi), (KIND_FLEX_SIN, -1.0), (fx, -pi)],
+        6: [(KIND_FLEX_COS, 1.0), (KIND_FLEX_SIN, -1.0)],
+    }
+    if scheme not in table:
+        return None
+    return [Step(stop_ticks, kind, angle) for kind, angle in table[scheme]]
+
+
 def init(prm, meas):
     ix = Indexer(prm=prm, cmd_angle=meas, target=meas, move_start=meas, prev_meas=meas)
     if prm.n_steps == 0:
@@ -224,3 +219,16 @@ def update(ix, meas, yaw_p):
     if arrived and ix.target_known:
         ix.step = (ix.step + 1) % ix.prm.n_steps
         _start_stop(ix)
+
+
+def run(prm, meas0, meas, yaw_b):
+    """Per-tick records of a whole run (mirrors the test hook
+    pyins_t_indexing_run of c_api_testing.cpp)."""
+    ix = init(prm, meas0)
+    out = []
+    for k in range(len(yaw_b)):
+        m = meas[k] if meas is not None else ix.cmd_angle
+        update(ix, m, yaw_b[k] + m)
+        out.append((ix.state, ix.step, ix.fault, ix.fallbacks, ix.cmd_angle, ix.cmd_rate,
+                    ix.a_c, ix.a_s))
+    return out

@@ -1,10 +1,18 @@
-"""Plots and report.html for a run directory (``pyins report RUNDIR``).
+"""A run's page and figures: the plots and report.html of a run directory (``pyins report RUNDIR``).
 
-Reads only what ``pyins.runs.execute`` wrote (summary.json, the variants'
+Reads only what `pyins.runs.execute` wrote (summary.json, the variants'
 timeseries.npz), so a report can be re-rendered, or rendered for a partial
-run, without running anything. Units follow the papers: position errors in m
-or nmi (whichever reads better), level errors in arc-seconds, heading errors
-in arc-minutes.
+run, without running anything. Units follow the papers (`pyins.metrics`):
+position errors in m or nmi (whichever reads better), level errors in
+arc-seconds, heading errors in arc-minutes.
+
+`render`:
+1. the figures: navigation errors, the alignment's convergence, the
+   turntable and the flexible scheme's sums, the scheme comparison (each
+   when the run has something to show);
+2. the results table (a column per metric a paper figure may name), the
+   group metrics and the paper's figures beside ours;
+3. report.html, with the scenario as run.
 """
 import html
 import json
@@ -12,25 +20,14 @@ import os
 
 import numpy as np
 
-from pyins.reference import earth
+from pyins import runs
+from pyins.metrics import FIGURE_METRICS, display
+from pyins.report.plotting import pyplot
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, UNITS
 
-ARCSEC, ARCMIN, NMI = earth.ARCSEC_TO_RAD, earth.ARCMIN_TO_RAD, earth.NMI_TO_M
-UNIT_OF = {"horizontal_error_final": ("m", 1.0), "horizontal_error_max": ("m", 1.0),
-           "level_error_final": ("arcsec", ARCSEC), "level_error_max": ("arcsec", ARCSEC),
-           "heading_error_final": ("arcmin", ARCMIN), "heading_error_max": ("arcmin", ARCMIN),
-           "velocity_error_max": ("m/s", 1.0),
-           "level_error_vs_limit_final": ("arcsec", ARCSEC),
-           "heading_error_vs_limit_final": ("arcmin", ARCMIN), "att_east_gap_final": ("arcmin", ARCMIN),
-           "att_up_gap_final": ("arcmin", ARCMIN),
-           "drift_north_gap_final": ("deg/h", earth.DPH_TO_RPS),
-           "level_error_std": ("arcsec", ARCSEC), "heading_error_std": ("arcmin", ARCMIN)}
+__all__ = ["render", "plot_errors", "plot_alignment", "plot_table", "plot_comparison"]
 
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")              # files only, no display
-    import matplotlib.pyplot as plt
-    return plt
+_MIN, _HOUR = UNITS["time"]["min"], UNITS["time"]["h"]
 
 
 def _load(run_dir):
@@ -47,20 +44,20 @@ def _load(run_dir):
 
 def _time_axis(t_s):
     span = t_s[-1] if len(t_s) else 0.0
-    return (t_s / 3600.0, "time [h]") if span > 3 * 3600 else (
-        (t_s / 60.0, "time [min]") if span > 1200 else (t_s, "time [s]"))
+    return (t_s / _HOUR, "time [h]") if span > 3 * _HOUR else (
+        (t_s / _MIN, "time [min]") if span > 20 * _MIN else (t_s, "time [s]"))
 
 
 def plot_errors(summary, series, path):
-    plt = _pyplot()
+    plt = pyplot()
     big = max((s["horizontal_m"].max() for s in series.values() if len(s["horizontal_m"])), default=0)
-    pos_scale, pos_unit = (NMI, "nmi") if big > 0.5 * NMI else (1.0, "m")
+    pos_scale, pos_unit = (NMI_TO_M, "nmi") if big > 0.5 * NMI_TO_M else (1.0, "m")
     fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
     for label, s in series.items():
         t, tl = _time_axis(s["time_s"])
         ax[0].plot(t, s["horizontal_m"] / pos_scale, label=label)
-        ax[1].plot(t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC, label=label)
-        ax[2].plot(t, s["att_err_n_rad"][:, 2] / ARCMIN, label=label)
+        ax[1].plot(t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, label=label)
+        ax[2].plot(t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, label=label)
         ax[3].plot(t, np.hypot(s["vel_err_n_mps"][:, 0], s["vel_err_n_mps"][:, 1]), label=label)
         ax[3].set_xlabel(tl)
     for a, yl in zip(ax, [f"horizontal position error [{pos_unit}]", "max |level error| [arcsec]",
@@ -77,13 +74,13 @@ def plot_errors(summary, series, path):
 
 def plot_alignment(summary, series, path):
     """Attitude errors and the filter's sigma over the alignment (if any)."""
-    plt = _pyplot()
+    plt = pyplot()
     aligning = {k: s for k, s in series.items() if (s["outputs"]["mode"] != 3).any()}
     if not aligning:
         return False
     fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     names = ["phi_E [arcsec]", "phi_N [arcsec]", "phi_U [arcmin]"]
-    scale = [ARCSEC, ARCSEC, ARCMIN]
+    scale = [ARCSEC_TO_RAD, ARCSEC_TO_RAD, ARCMIN_TO_RAD]
     for label, s in aligning.items():
         t, tl = _time_axis(s["time_s"])
         for i in range(3):
@@ -107,7 +104,7 @@ def plot_alignment(summary, series, path):
 
 def plot_table(summary, series, path):
     """Table angle, IMU heading and A_c/A_s of the rotating variants."""
-    plt = _pyplot()
+    plt = pyplot()
     turning = {k: s for k, s in series.items()
                if np.any(s["outputs"]["index_state"] != 0) or np.any(s["outputs"]["table_angle_rad"] != 0)}
     if not turning:
@@ -134,12 +131,12 @@ def plot_table(summary, series, path):
 
 def plot_comparison(summary, path):
     """Final and maximum horizontal errors per variant, the paper's beside."""
-    plt = _pyplot()
+    plt = pyplot()
     vs = [v for v in summary["variants"] if "horizontal_error_max" in v["metrics"]]
     if len(vs) < 2:
         return False
     big = max(v["metrics"]["horizontal_error_max"] for v in vs)
-    sc, un = (NMI, "nmi") if big > 0.5 * NMI else (1.0, "m")
+    sc, un = (NMI_TO_M, "nmi") if big > 0.5 * NMI_TO_M else (1.0, "m")
     x = np.arange(len(vs))
     fig, ax = plt.subplots(figsize=(9, 4.5))
     ax.bar(x - 0.25, [v["metrics"]["horizontal_error_final"] / sc for v in vs], 0.25, label="ours, final")
@@ -171,8 +168,8 @@ def _ours(row):
 
 def render(run_dir):
     """Write the plots and report.html into ``run_dir``; returns the path."""
-    from pyins import runs
     summary, series = _load(run_dir)
+    # 1. the figures
     figs = []
     if series:
         plot_errors(summary, series, os.path.join(run_dir, "errors.png"))
@@ -183,16 +180,17 @@ def render(run_dir):
             figs.append(("table.png", "Turntable angle, IMU heading and the flexible scheme's sums"))
     if plot_comparison(summary, os.path.join(run_dir, "comparison.png")):
         figs.append(("comparison.png", "Scheme comparison"))
+    # 2. the results, the group metrics, the paper's figures
     esc = html.escape
-    metric_names = [k for k in UNIT_OF if any(k in v["metrics"] for v in summary["variants"])]
+    metric_names = [k for k in FIGURE_METRICS if any(k in v["metrics"] for v in summary["variants"])]
     head = "".join(f"<th>{esc(k)}</th>" for k in metric_names)
     body = []
     for v in summary["variants"]:
-        cells = "".join(f"<td>{_fmt(v['metrics'][k], UNIT_OF[k]) if k in v['metrics'] else ''}</td>"
+        cells = "".join(f"<td>{_fmt(v['metrics'][k], display(k)) if k in v['metrics'] else ''}</td>"
                         for k in metric_names)
         done = "" if v["complete"] else f" (partial: {v['ticks_done']} of {v['ticks']} ticks)"
         body.append(f"<tr><td>{esc(v['label'])}{esc(done)}</td>{cells}</tr>")
-    group = "".join(f"<li>{esc(k)}: {_fmt(val, UNIT_OF[k])}</li>"
+    group = "".join(f"<li>{esc(k)}: {_fmt(val, display(k))}</li>"
                     for k, val in summary.get("group_metrics", {}).items())
     paper = summary.get("paper") or {}
     prow = "".join(
@@ -206,6 +204,7 @@ def render(run_dir):
                       f"<p class='note'>{esc(paper.get('note', ''))}</p>"
                       "<table><tr><th>metric</th><th>variant</th><th>paper</th><th>ours</th>"
                       f"<th>verdict</th><th>note</th></tr>{prow}</table>")
+    # 3. the page
     scen_text = ""
     scen_path = os.path.join(run_dir, "scenario.toml")
     if os.path.exists(scen_path):

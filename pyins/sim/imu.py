@@ -123,8 +123,8 @@ def wrap_two_pi_mod(angle):
     """Angle wrapped to [0, 2 pi) by ``np.mod``, vectorised (the true table angle).
 
     ``np.mod`` takes the exact floating remainder, so this can differ in the
-    last bits from `pyins.sim.turntable.wrap_two_pi`, the plant's
-    ``a - 2 pi floor(a / 2 pi)``.
+    last bits from `pyins.reference.angle.wrap_two_pi`, the core's (and
+    the plant's) ``a - 2 pi floor(a / 2 pi)``.
     """
     a = np.mod(angle, TWO_PI)
     return np.where(a >= TWO_PI, 0.0, a)

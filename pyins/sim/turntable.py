@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pyins.reference.angle import wrap_two_pi  # the core's, which plant.cpp wraps with
 from pyins.sim.exact_time import as_times, frac_cycles
 from pyins.units import DEG_TO_RAD, TWO_PI
 
@@ -141,15 +142,6 @@ def apply_errors(m, bias, quantum, noise, dt, res, x):
             v = q
         out[i] = v
     return out
-
-
-def wrap_two_pi(a):
-    """The encoder angle in [0, 2 pi): ``a - 2 pi floor(a / 2 pi)``, a result
-    rounding to 2 pi giving 0 (mirrors plant.cpp's wrap_two_pi, scalar; the
-    simulator's vectorised `pyins.sim.imu.wrap_two_pi_mod` reduces with
-    ``np.mod`` instead and can differ from it in the last bits)."""
-    w = a - TWO_PI * np.floor(a / TWO_PI)
-    return 0.0 if w >= TWO_PI else w
 
 
 def plant_tick(cfg, st, errors, omega_b, force_b, x, w, gyro_noise, accel_noise, dt):

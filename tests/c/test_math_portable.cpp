@@ -9,6 +9,7 @@
 // line is "N passed, M failed". A hash of every pmath output is printed so
 // that builds at different optimisation levels can be compared bit for bit.
 #include "math_portable.hpp"
+#include "units.hpp"
 
 #include <cfloat>
 #include <cinttypes>
@@ -23,7 +24,7 @@ namespace {
 
 namespace pm = pyins::pmath;
 
-constexpr double kPi = 3.14159265358979323846;
+using pyins::kPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kPoints = 200000;

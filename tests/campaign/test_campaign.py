@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from pyins import campaign, scenario
+from pyins.campaign import execute as campaign_execute
 from pyins.scenario import ScenarioError
 
 HEADINGS = "motion.heading=0 deg,60 deg,120 deg,180 deg,240 deg,300 deg"
@@ -63,7 +64,7 @@ def test_builtin_campaigns_load():
 
 def test_seed000_static_points_match_the_tool():
     """6 headings x 5 runs, seeds 1000 * heading + run as
-    tools/reproduce_seed000.py, the base's [compare] over seeds dropped."""
+    tools/papers/reproduce_seed000.py, the base's [compare] over seeds dropped."""
     camp = campaign.load_campaign("seed000_static")
     assert [p.seed for p in camp.points[:6]] == [0, 1, 2, 3, 4, 60000]
     assert camp.points[-1].seed == 300004
@@ -163,7 +164,7 @@ def test_dask_cluster_gives_identical_aggregates(local_run, tmp_path):
 
 def test_dask_needs_a_reachable_scheduler(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr(campaign, "DASK_CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(campaign_execute, "DASK_CONNECT_TIMEOUT", "1s")
     camp = campaign.from_args("seed000_static", ["motion.heading=0 deg"], 1)
     with pytest.raises(campaign.CampaignError, match="cannot connect to the Dask scheduler"):
         campaign.run_campaign(camp, tmp_path, scheduler="tcp://127.0.0.1:9", plots=False)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from pyins import campaign, sim
-from pyins.report import ARCMIN
+from pyins.report import campaign as campaign_report
+from pyins.units import ARCMIN_TO_RAD as ARCMIN
 
 TINY = """
 [campaign]
@@ -102,4 +103,4 @@ def test_two_group_keys_give_a_table_and_plots_by_key(tiny):
     # one group key: no table by key, no plot by key
     single = campaign.from_args(camp.base, {"motion.heave": camp.grid["motion.heave"]},
                                 overrides=dict(camp.overrides))
-    assert campaign._pivot_lines(single, [], 1.0) == []
+    assert campaign_report.pivot_lines(single, [], 1.0) == []

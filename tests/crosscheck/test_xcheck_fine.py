@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from pyins import native, runner, sim
 from pyins.reference import attitude, earth
 from pyins.reference import firmware as ref_firmware
+from pyins.units import DT
 
 DEG = earth.DEG_TO_RAD
 
@@ -78,7 +79,7 @@ def test_fine_filter_module_state_and_full_covariance(states, lat, meas_every, n
     for k in range(n):
         fine_align.step(f, dv[k])
     cp = hooks.ffi.new("pyins_t_fine_params *")
-    cp.sin_lat, cp.cos_lat, cp.gravity, cp.dt = prm.sin_lat, prm.cos_lat, g, 0.01
+    cp.sin_lat, cp.cos_lat, cp.gravity, cp.dt = prm.sin_lat, prm.cos_lat, g, DT
     cp.meas_every, cp.gyro_arw, cp.accel_vrw = meas_every, arw, vrw
     for i in range(3):
         cp.sigma0_att[i] = prm.sigma0_att[i]

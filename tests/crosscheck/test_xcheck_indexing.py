@@ -15,8 +15,9 @@ from hypothesis import strategies as st
 
 import hooks
 from pyins.reference import indexing as ix
+from pyins.units import DEG_TO_RAD, DT
 
-DEG = np.pi / 180.0
+DEG = DEG_TO_RAD
 RECORD = np.dtype([("state", "i4"), ("step", "i4"), ("fault", "i4"), ("fallbacks", "i4"),
                    ("cmd_angle", "f8"), ("cmd_rate", "f8"), ("a_c", "f8"), ("a_s", "f8")])
 
@@ -28,7 +29,7 @@ def setups(draw):
     steps = ix.preset_steps(scheme, stop)
     prm = ix.Params(steps=steps, rate=draw(st.sampled_from([6.0, 10.0, 30.0])) * DEG,
                     accel=draw(st.sampled_from([30.0, 100.0, 1e4])) * DEG, delta=0.01,
-                    max_flex=2 * np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=0.01,
+                    max_flex=2 * np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=DT,
                     sums=draw(st.sampled_from([ix.SUMS_STOPS, ix.SUMS_ALL])))
     n = draw(st.integers(500, 6000))
     t = np.arange(n) * 0.01

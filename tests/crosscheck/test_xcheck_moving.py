@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 import hooks
 from pyins.reference import attitude, coarse_align, earth, moving_align  # noqa: I001
+from pyins.units import DT
 
 ffi, lib = hooks.ffi, hooks.lib
 DEG = earth.DEG_TO_RAD
@@ -73,7 +74,7 @@ def test_moving_align_filter(lat, every, n, window, seed):
     sl, cl = np.sin(lat * DEG), np.cos(lat * DEG)
     rm, rn = earth.principal_radii(sl)
     prm = moving_align.Params(
-        sin_lat=sl, cos_lat=cl, rm_h=rm, rn_h=rn, dt=0.01, meas_every=every,
+        sin_lat=sl, cos_lat=cl, rm_h=rm, rn_h=rn, dt=DT, meas_every=every,
         gyro_arw=rng.uniform(1e-7, 1e-5), accel_vrw=rng.uniform(1e-5, 1e-3),
         pos_sigma=rng.uniform(0.05, 1.0), sigma0_att=rng.uniform(1e-4, 1e-2, 3),
         sigma0_vel=rng.uniform(0.05, 1.0), sigma0_gyro=rng.uniform(1e-8, 1e-6),

@@ -7,10 +7,11 @@ import pytest
 
 from pyins import native, runner, sim
 from pyins.reference import attitude, earth
+from pyins.units import ARCSEC_TO_RAD, G0, TICK_HZ
 
 lib = native.lib
 DEG = earth.DEG_TO_RAD
-ARCSEC = DEG / 3600.0
+ARCSEC = ARCSEC_TO_RAD
 BOOKKEEPING = ("fault_flags", "n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_repeats",
                "n_seq_lost", "n_encoder_jumps", "seq")
 
@@ -201,7 +202,7 @@ def test_saturated_sample_rejected_and_held_then_bridged():
     full = native.Firmware(SEQ).run(s)
     bad = s.copy()
     bad["dtheta_p_rad"][300, 0] = 400.0 * DEG / 100.0          # exactly at the limit
-    bad["dv_p_mps"][600, 2] = -20.0 * 9.80665 / 100.0 * 1.5
+    bad["dv_p_mps"][600, 2] = -20.0 * G0 / TICK_HZ * 1.5
     fw = native.Firmware(SEQ)
     with pytest.raises(native.SampleError) as info:
         fw.run(bad)

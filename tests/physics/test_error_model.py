@@ -49,8 +49,8 @@ def test_static_run_matches_linear_error_model(scheme):
 
 
 def test_drift_surviving_proxy():
-    """SPEC 1.10's proxy: a fixed IMU keeps all of a constant drift (1), a
-    uniform full turn cancels it (0 to rounding), and the masked parts add
+    """The proxy of docs/papers.md, seed 002 §10: a fixed IMU keeps all of a
+    constant drift (1), a uniform full turn cancels it (0 to rounding), and the masked parts add
     up as vectors to the whole."""
     assert analysis.drift_surviving(np.full(100, 0.3)) == pytest.approx(1.0, abs=1e-15)
     turn = np.linspace(0.0, 2 * np.pi, 3600, endpoint=False)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from pyins import fil, runner, sim
+from pyins import fil, progress, runner, sim
 from pyins.reference import earth
 from pyins.sim import turntable
 
@@ -70,13 +70,13 @@ def test_text_progress_draws_on_a_terminal():
             return True
 
     s = Tty()
-    p = fil.TextProgress(stream=s)
+    p = progress.TextProgress(stream=s)
     p(180_000, 360_000)
     p(360_000, 360_000)
     text = s.getvalue()
     assert "0.50/1.00 h ship time" in text and text.endswith("\n")
     quiet = io.StringIO()
-    fil.TextProgress(stream=quiet)(1, 2)
+    progress.TextProgress(stream=quiet)(1, 2)
     assert quiet.getvalue() == ""
 
 

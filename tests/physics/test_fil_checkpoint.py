@@ -14,7 +14,7 @@ import time
 import numpy as np
 import pytest
 
-from pyins import fil, sim
+from pyins import fil, records, sim
 
 TICKS = 240_000                  # 40 min of ship time: 12 chunks of 20,000
 CHUNK = 20_000
@@ -55,7 +55,7 @@ def test_killed_run_resumes_bit_identical(tmp_path):
     cut = tmp_path / "cut"
     proc = subprocess.Popen([sys.executable, "-c", RUN, str(cut)])
     try:
-        _wait_for_checkpoint(str(cut / fil.CHECKPOINT), proc, 4 * CHUNK)
+        _wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CHUNK)
         time.sleep(0.08)                 # let it write a chunk past the checkpoint
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=30)
@@ -63,14 +63,14 @@ def test_killed_run_resumes_bit_identical(tmp_path):
         if proc.poll() is None:
             proc.kill()
     # what was written before the kill is readable and is the start of the whole run
-    part_out, part_plant, info = fil.load_records(str(cut))
+    part_out, part_plant, info = records.load_records(str(cut))
     assert not info["complete"] and 0 < len(part_out) < len(whole.outputs)
     assert part_out.tobytes() == np.asarray(whole.outputs[:len(part_out)]).tobytes()
     resumed = _run(str(cut), checkpoint_ticks=2 * CHUNK, resume=True)
     assert len(resumed.outputs) == len(whole.outputs) == TICKS // 100
     assert np.asarray(resumed.outputs).tobytes() == np.asarray(whole.outputs).tobytes()
     assert np.asarray(resumed.plant).tobytes() == np.asarray(whole.plant).tobytes()
-    _, _, info = fil.load_records(str(cut))
+    _, _, info = records.load_records(str(cut))
     assert info["complete"] and info["ticks_done"] == TICKS
 
 

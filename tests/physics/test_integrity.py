@@ -7,7 +7,7 @@ sets a sticky fault bit and the attitude is never flagged valid again.
   holds): PYINS_FAULT_ALIGN_INCONSISTENT.
 - Coarse alignment: seed 000's TRIAD on a heaving ship keeps moving by tens
   of arc-minutes: PYINS_FAULT_COARSE_UNSETTLED.
-Seed 000's sensor errors throughout (tools/reproduce_seed000.sensors)."""
+Seed 000's sensor errors throughout (tools/papers/reproduce_seed000.sensors)."""
 import os
 import sys
 
@@ -17,7 +17,7 @@ import pytest
 from pyins import native, runner, sim
 from pyins.reference import earth
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools", "papers"))
 from reproduce_seed000 import sensors  # noqa: E402
 
 DEG = earth.DEG_TO_RAD

@@ -97,11 +97,11 @@ def test_fit_equals_the_swing_case_with_sensor_errors():
     # Seed 000's errors (0.01 deg/h, 100 ug, ARW/VRW of seeds 002/003), the
     # general sea state at heading 60, 3 noise seeds: the moored ship's FIT
     # heading at 300 s within 1' of the pure swing's, lever arm known or
-    # not (acceptance: 3'; tools/moored_alignment.py measures all cases).
+    # not (acceptance: 3'; tools/papers/moored_alignment.py measures all cases).
     base = sim.sea_state("general", LAT, LON, 0.0, yaw0=-60 * DEG)
     swing = sim.ShipAtSea(base)
     moored = sim.moored("general", LAT, LON, 0.0, -60 * DEG)
-    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools"))
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools", "papers"))
     from reproduce_seed000 import sensors
     for seed in range(3):
         ref = _align(swing, 1, 300, sensors(seed=seed)[0])[30000][2]

@@ -13,6 +13,7 @@ from numpy.testing import assert_allclose
 
 import hooks
 from pyins.reference import attitude
+from pyins.units import DEG_TO_RAD
 from strategies import euler_angles, quaternions, rotation_vectors, unit_vectors
 
 ENGINES = {"reference": attitude, "core": hooks}
@@ -75,7 +76,7 @@ def test_euler_convention(e):
 
 
 def test_heading_and_yaw():
-    deg = np.pi / 180
+    deg = DEG_TO_RAD
     assert attitude.yaw_to_heading(0.0) == 0.0
     assert np.signbit(attitude.yaw_to_heading(-0.0)) is np.False_ or attitude.yaw_to_heading(-0.0) == 0.0
     assert not np.signbit(attitude.yaw_to_heading(0.0))

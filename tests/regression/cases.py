@@ -10,7 +10,7 @@ alignment grids and stops, so every mode and every branch of a scheme runs.
 """
 import numpy as np
 
-from pyins import runner, sim
+from pyins import native, runner, sim
 from pyins.reference import earth
 
 DEG = earth.DEG_TO_RAD
@@ -90,7 +90,6 @@ def run(cfg, dtheta, dv, seq):
     (an ideal table, as in the embedded demo; the increments do not turn with
     it: the records test bits, not physics). A rejected sample keeps the
     record the call wrote."""
-    from pyins import native
     ffi, lib = native.ffi, native.lib
     fw = native.Firmware(cfg)
     out = np.zeros(len(dtheta), dtype=native.OUTPUT_DTYPE)

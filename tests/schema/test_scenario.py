@@ -11,7 +11,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from pyins import scenario, sim
+from pyins import runs, scenario, sim
 from pyins.reference import attitude, earth
 from pyins.scenario import ScenarioError
 from pyins.units import UNITS, parse_quantity
@@ -25,7 +25,7 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
 
 def _tool(name):
     """tools/<name>.py as a module (the scripts that reproduce the papers)."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / "papers" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -482,14 +482,14 @@ def test_unknown_builtin_or_missing_file():
 # ---------------------------------------------------------------------------
 def test_smoke_builtin_run_equals_the_reproduce_tool_run():
     """The flexible run of seed002_exp1, shortened to 500 ticks, through
-    fil.run_fil: bit-identical to the run tools/reproduce_seed002.py starts."""
+    fil.run_fil: bit-identical to the run tools/papers/reproduce_seed002.py starts."""
     fil = pytest.importorskip("pyins.fil")
     from pyins import runner
     tool = _tool("reproduce_seed002")
     sc = scenario.load("seed002_exp1").with_overrides({"duration": "5 s", "record_every": "0.5 s"})
     run = list(sc.runs())[2]
     assert run.label == "flexible two-position" and run.duration_ticks == 500 and run.every == 50
-    ours = run.run()
+    ours = runs.run(run)
     m = sim.HeadingSwing.experiment(1)
     theirs = fil.run_fil(m, 500, config=dict(index_scheme=4, **tool.initial_errors(m)),
                          errors=sim.preset("seed002"), seed=1, every=50)

@@ -1,7 +1,7 @@
 """Scenario files of a ship at the pier: heave, surge and sway (sinusoids or a
 wave spectrum) and lever arms in [motion], firmware.lever and
 firmware.coarse_method; the moored built-ins against pyins.sim.moored and
-tools/moored_alignment.py; files without these keys unchanged (motion and
+tools/papers/moored_alignment.py; files without these keys unchanged (motion and
 digest); one clear line per mistake; a short run through the firmware."""
 import importlib.util
 from dataclasses import fields
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyins import runner, scenario, sim
+from pyins import runner, runs, scenario, sim
 from pyins.reference import earth
 from pyins.scenario import ScenarioError
 
@@ -23,7 +23,7 @@ SEEDS_PAPERS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "see
 
 
 def _tool(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / "papers" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -58,9 +58,9 @@ heading = "240 deg"
 # Built-ins
 # ---------------------------------------------------------------------------
 def test_moored_builtins_match_sim_moored_and_the_tool():
-    """The ship of pyins.sim.moored, the sensors of tools/reproduce_seed000.py
-    (tools/moored_alignment.py uses both) and its seeds, TRIAD's 300-s alignment
-    on a 2 s grid (tools/moored_alignment.py's TRIAD run) for both methods."""
+    """The ship of pyins.sim.moored, the sensors of tools/papers/reproduce_seed000.py
+    (tools/papers/moored_alignment.py uses both) and its seeds, TRIAD's 300-s alignment
+    on a 2 s grid (tools/papers/moored_alignment.py's TRIAD run) for both methods."""
     tool = _tool("reproduce_seed000")
     for state in ("ideal", "general", "bad"):
         sc = scenario.load(f"moored_{state}")
@@ -301,12 +301,12 @@ def test_smoke_moored_run_equals_a_direct_fil_run():
     cfg = dict(coarse_ticks=3000, coarse_method=1, coarse_output_every_ticks=200, coarse_ratio=0.5,
                euler_b_rad=[0.0, 0.0, 0.0], index_scheme=0)
     fit = list(sc.runs())[1]
-    ours = fit.run()
+    ours = runs.run(fit)
     theirs = fil.run_fil(m, 3000, config=cfg, errors=tool.sensors(seed=240007)[1], seed=240007, every=200)
     assert len(ours.outputs) == 15 and ours.outputs.tobytes() == theirs.outputs.tobytes()
     # the truth is the reference point's: zero lever arm -> the same position, another velocity
     assert np.array_equal(ours.truth.lat, m.reference_state(ours.outputs["tick"] * 0.01).lat)
-    unknown = list(sc.with_overrides({"firmware.lever": "unknown"}).runs())[1].run()
+    unknown = runs.run(list(sc.with_overrides({"firmware.lever": "unknown"}).runs())[1])
     theirs_u = fil.run_fil(m, 3000, config=dict(cfg, lever_b_m=np.zeros(3), lever_p_m=np.zeros(3)),
                            errors=tool.sensors(seed=240007)[1], seed=240007, every=200)
     assert unknown.outputs.tobytes() == theirs_u.outputs.tobytes() != ours.outputs.tobytes()

@@ -51,7 +51,7 @@ def test_as_times():
 def test_the_two_wraps_agree_within_a_turn_and_part_beyond():
     # Within a turn either side of [0, 2 pi) the plant's a - 2 pi floor(a / 2 pi)
     # and np.mod give the same bits; many turns out they need not (why the
-    # plant mirror keeps its own).
+    # truth and the plant keep two functions).
     a = np.random.default_rng(1).uniform(-np.pi, 3 * np.pi, 5000)
     plant = np.array([turntable.wrap_two_pi(x) for x in a])
     np.testing.assert_array_equal(plant, imu.wrap_two_pi_mod(a))

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compare the indexing schemes on the horizontal gyro drifts alone.
 
-    .venv/bin/python tools/compare_schemes.py [--hours 72] [--out runs/compare_schemes]
+    .venv/bin/python tools/papers/compare_schemes.py [--hours 72] [--out runs/compare_schemes]
 
 Firmware in the loop, 0.003 deg/h on the IMU's x and y gyros as the only
 error (the error the schemes are designed against), on seed 002's two
@@ -9,10 +9,10 @@ heading swings and a static ship (heading 15 deg, seed 002's site and
 attitude), with the firmware's 30 deg/s^2 turns and with the paper's
 constant-rate turns (600 deg/s^2, on the swings). For each ship and scheme:
 maximum and final horizontal error, the fraction of a constant x/y drift
-that survives (SPEC 1.10's proxy) and the flexible fallbacks. The schemes:
-none, traditional two-position, seed 002's flexible scheme (literal), its
-derivation form, and both with index_sums = all (the turns summed too; our
-extension, docs/indexing.md "What the turns leave").
+that survives (the proxy of docs/papers.md, seed 002 §10) and the flexible
+fallbacks. The schemes: none, traditional two-position, seed 002's flexible
+scheme (literal), its derivation form, and both with index_sums = all (the
+turns summed too; our extension, docs/indexing.md "What the turns leave").
 
 Writes table.md and compare_schemes.json (figure names with units) in --out.
 """
@@ -24,11 +24,11 @@ import sys
 import numpy as np
 
 from pyins import analysis, fil, runner, sim
-from pyins.reference import earth
 from pyins.sim import motion
 from pyins.sim.turntable import TableConfig
+from pyins.units import DEG_TO_RAD as DEG
+from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
 
-DEG = earth.DEG_TO_RAD
 #: (id, scheme, index_sums, label)
 VARIANTS = (("none", 0, 0, "no rotation"), ("two", 2, 0, "traditional"),
             ("flex", 4, 0, "flexible, literal"), ("derived", 6, 0, "derivation form"),
@@ -49,14 +49,14 @@ def ship(name):
 
 
 def run_one(m, scheme, sums, accel_deg, hours, progress):
-    drift = 0.003 * earth.DPH_TO_RPS
+    drift = 0.003 * DPH_TO_RPS
     errors = sim.SensorErrors(gyro_bias=np.array([drift, drift, 0.0]))
-    res = fil.run_fil(m, int(hours * 360_000), errors=errors, every=100,
+    res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), errors=errors, every=TICK_HZ,
                       config=dict(index_scheme=scheme, index_sums=sums, index_accel_rad_s2=accel_deg * DEG),
                       table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress)
     e = runner.nav_errors(res)
-    return {"max_nmi": float(e.horizontal_m.max() / earth.NMI_TO_M),
-            "final_nmi": float(e.horizontal_m[-1] / earth.NMI_TO_M),
+    return {"max_nmi": float(e.horizontal_m.max() / NMI_TO_M),
+            "final_nmi": float(e.horizontal_m[-1] / NMI_TO_M),
             "survives": analysis.drift_surviving(res.outputs["yaw_p_rad"]),
             "fallbacks": int(res.outputs["index_fallbacks"][-1])}
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Alignment on a moored ship: heave, surge, sway and a lever arm.
 
-    .venv/bin/python tools/moored_alignment.py [--out runs/moored] [--seeds 10]
+    .venv/bin/python tools/papers/moored_alignment.py [--out runs/moored] [--seeds 10]
 
 For each of seed 000's sea states (ideal, general, bad) and each heading of
 its static test (0..300 deg, step 60), with seed 000's sensor errors (gyro
@@ -34,11 +34,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reproduce_seed000 import HEADINGS, LAT, LON, limit_euler, sensors  # noqa: E402
 
 from pyins import native, runner, sim  # noqa: E402
-from pyins.reference import earth  # noqa: E402
-
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
+from pyins.units import ARCMIN_TO_RAD as ARCMIN  # noqa: E402
+from pyins.units import ARCSEC_TO_RAD as ARCSEC  # noqa: E402
+from pyins.units import DEG_TO_RAD as DEG  # noqa: E402
+from pyins.units import TICK_HZ, TWO_PI  # noqa: E402
 SEA_STATES = ("ideal", "general", "bad")
 TIMES_S = (200, 300, 600)
 #: The alignments compared: (label, firmware configuration). Durations in
@@ -61,7 +60,7 @@ def motions(state, heading):
 
 
 def wrap(a):
-    return (a + np.pi) % (2 * np.pi) - np.pi
+    return (a + np.pi) % TWO_PI - np.pi
 
 
 def run_case(m, exact, model, align, lever_known):
@@ -81,13 +80,13 @@ def main(argv=None):
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     t0 = time.time()
-    n = TIMES_S[-1] * 100
+    n = TIMES_S[-1] * TICK_HZ
     rows = []   # dicts, one per (state, heading, case, alignment, seed, time)
     for state in SEA_STATES:
         for h in HEADINGS:
             for name, m in motions(state, h).items():
                 exact = sim.exact_increments(m, n)[:2]
-                truth = {t: sim.truth_at(m, np.array([t * 100])) for t in TIMES_S}
+                truth = {t: sim.truth_at(m, np.array([t * TICK_HZ])) for t in TIMES_S}
                 cases = [(name, True)] if name == "swing" else [(name, True), (name + "_unknown_lever", False)]
                 for s in range(args.seeds):
                     _, errs = sensors(seed=7 + 1000 * h + s)
@@ -97,7 +96,7 @@ def main(argv=None):
                             model, _ = sensors(seed=7 + 1000 * h + s)   # the same draw for every case
                             rec = run_case(m, exact, model, align, known)
                             for t in TIMES_S:
-                                i = np.flatnonzero(rec["tick"] == t * 100)
+                                i = np.flatnonzero(rec["tick"] == t * TICK_HZ)
                                 if not len(i):
                                     continue
                                 d = wrap(rec["euler_b_rad"][i[0]] - truth[t].euler[0])

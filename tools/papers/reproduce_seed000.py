@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reproduce seed 000 (inertial-frame coarse alignment) with the C++ firmware.
 
-    .venv/bin/python tools/reproduce_seed000.py [--out runs/seed000] [--seeds 5]
+    .venv/bin/python tools/papers/reproduce_seed000.py [--out runs/seed000] [--seeds 5]
 
 Writes into --out:
 - table1_static.csv / .md: 6 headings x N noise seeds, pitch/roll/heading
@@ -30,11 +30,11 @@ import sys
 import numpy as np
 
 from pyins import analysis, runner, sim
-from pyins.reference import earth
-
-DEG = earth.DEG_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
+from pyins.reference.config import DEFAULT_COARSE_FIRST_S
+from pyins.units import ARCMIN_TO_RAD as ARCMIN
+from pyins.units import ARCSEC_TO_RAD as ARCSEC
+from pyins.units import DEG_TO_RAD as DEG
+from pyins.units import DPH_TO_RPS, TICK_HZ, TWO_PI, UG_TO_MPS2
 LAT, LON = 34.246 * DEG, 108.910 * DEG
 HEADINGS = (0, 60, 120, 180, 240, 300)
 
@@ -44,8 +44,8 @@ def sensors(gyro_dph=0.01, accel_ug=100.0, seed=0, noise=True):
     if noise:
         e.gyro_arw = sim.preset("seed002").gyro_arw       # 0.0005 deg/sqrt(h)
         e.accel_vrw = sim.preset("seed002").accel_vrw     # 5 ug/sqrt(Hz)
-    e.gyro_bias = np.full(3, gyro_dph * earth.DPH_TO_RPS)
-    e.accel_bias = np.full(3, accel_ug * earth.UG_TO_MPS2)
+    e.gyro_bias = np.full(3, gyro_dph * DPH_TO_RPS)
+    e.accel_bias = np.full(3, accel_ug * UG_TO_MPS2)
     return sim.SensorModel(e, seed=seed), e
 
 
@@ -57,8 +57,8 @@ def motion(state, heading):
 
 
 def align(m, seconds, model, ratio=0.5):
-    n = int(seconds * 100)
-    res = runner.navigate(m, n, every=100, sensors=model,
+    n = int(seconds * TICK_HZ)
+    res = runner.navigate(m, n, every=TICK_HZ, sensors=model,
                           config=dict(coarse_ticks=n, coarse_ratio=ratio, euler_b_rad=[0.0, 0.0, 0.0]))
     return res, runner.nav_errors(res)
 
@@ -66,7 +66,7 @@ def align(m, seconds, model, ratio=0.5):
 def euler_errors(res, k=-1):
     """pitch, roll, heading errors [arcsec] of record k (heading = marine)."""
     d = res.outputs["euler_b_rad"][k] - res.truth.euler[k]
-    d = (d + np.pi) % (2 * np.pi) - np.pi
+    d = (d + np.pi) % TWO_PI - np.pi
     return np.array([d[0], d[1], -d[2]]) / ARCSEC
 
 
@@ -177,7 +177,9 @@ def curves(out, fig):
         for kw, label, r in zip(kws, labels, ratios):
             model, errs = sensors(seed=5, **kw)
             res, e = align(m, seconds, model, ratio=r)
-            ok = res.outputs["state_flags"] == 1
+            # every record after the first coarse output holds a solution; they
+            # are all provisional (ATT_VALID unset) while the coarse phase runs
+            ok = e.time_s > DEFAULT_COARSE_FIRST_S
             t = e.time_s[ok]
             lim = analysis.alignment_limits(LAT, m.state(np.array([0.0])).euler[0], errs.gyro_bias,
                                             errs.accel_bias).phi_n

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Reproduce seed 001 (static-base Kalman fine alignment) with the C++ firmware.
 
-    .venv/bin/python tools/reproduce_seed001.py [--out runs/seed001] [--seeds 10]
+    .venv/bin/python tools/papers/reproduce_seed001.py [--out runs/seed001] [--seeds 10]
 
-Seed 001's scenario (SPEC.md sec. 3.3): static, pitch -5 deg, roll 2 deg,
-yaw 235 deg, initial attitude error [10', 10', 60'], drifts 0.01 deg/h,
+Seed 001's scenario (docs/papers.md, seed 001 §3): static, pitch -5 deg,
+roll 2 deg, yaw 235 deg, initial attitude error [10', 10', 60'], drifts 0.01 deg/h,
 biases 100 ug, gyro noise 0.001 deg/sqrt(h), accelerometer noise
 10 ug/sqrt(Hz), 1200 s, feedback correction. The paper gives no latitude:
 we take 34.246 N (Xi'an, the authors' university).
@@ -22,15 +22,16 @@ import sys
 import numpy as np
 
 from pyins import analysis, runner, sim
-from pyins.reference import attitude, earth
+from pyins.reference import attitude
+from pyins.units import ARCMIN_TO_RAD as ARCMIN
+from pyins.units import DEG_TO_RAD as DEG
+from pyins.units import DPH_TO_RPS as DPH
+from pyins.units import TICK_HZ
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
-DPH = earth.DPH_TO_RPS
 LAT = 34.246 * DEG
 EULER = np.array([-5.0, 2.0, 235.0]) * DEG
 PHI0 = np.array([10.0, 10.0, 60.0]) * ARCMIN
-N = 120_000
+N = 1200 * TICK_HZ                 #: 1200 s of fine alignment [ticks]
 PAPER_GAPS = {"phi_E_arcmin": 0.07, "phi_U_arcmin": 2.0, "eps_N_dph": 0.002}
 
 
@@ -38,7 +39,7 @@ def run(states, seed):
     m = sim.Static(LAT, 108.91 * DEG, 0.0, *EULER)
     guess = attitude.mat_to_euler(attitude.rotvec_to_mat(-PHI0) @ attitude.euler_to_mat(EULER))
     errors = sim.preset("seed001")
-    res = runner.navigate(m, N, every=100, sensors=sim.SensorModel(errors, seed=seed),
+    res = runner.navigate(m, N, every=TICK_HZ, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(euler_b_rad=guess, fine_ticks=N, fine_states=states))
     lim = analysis.alignment_limits(LAT, EULER, errors.gyro_bias, errors.accel_bias)
     return res, runner.nav_errors(res), lim

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Reproduce seed 002 (flexible two-position scheme under heading motion, 72 h).
 
-    .venv/bin/python tools/reproduce_seed002.py [--out runs/seed002] [--hours 72]
+    .venv/bin/python tools/papers/reproduce_seed002.py [--out runs/seed002] [--hours 72]
 
 Experiments 1 and 2 (heading swing omega = 6 cos(pi t/60) and 6 cos(pi t/30)
 deg/s), its Table 1 initial state and initial errors (pitch/roll/heading
 -10", 10", 1'; velocity 0.01 m/s; position 10 m north and east), its Table 2
 sensor errors (preset seed002), for no rotation, the traditional two-position
-scheme and the flexible scheme (stops 300 s, 6 deg/s), literal (SPEC 1.6,
-scheme 4) and in the form of its derivation (eqs. 9-13, scheme 6). The
+scheme and the flexible scheme (stops 300 s, 6 deg/s), literal (docs/papers.md,
+seed 002 §6, scheme 4) and in the form of its derivation (eqs. 9-13, scheme 6). The
 paper's turns run at a constant 6 deg/s: we command 600 deg/s^2, which
 reaches 6 deg/s within one 10-ms tick (the firmware default, 30 deg/s^2,
 lengthens each cycle by 0.8 s; why that matters is in the report). Also the
@@ -21,7 +21,7 @@ extension; docs/indexing.md, "What the turns leave").
 Writes positions.png, table.md (final and maximum horizontal errors beside
 the paper's 8.57 / 3.70 / 2.97 and 16.13 / 12.90 / 1.98 nmi), report.md
 (the tables and why each figure differs from the paper's) and seed002.json.
-SPEC.md 1.7-1.10 explains why experiment 2's traditional result may not
+docs/papers.md, seed 002 §7-§10, explains why experiment 2's traditional result may not
 reproduce; nothing is tuned to match.
 """
 import argparse
@@ -32,12 +32,12 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, runner, sim
+from pyins import analysis, fil, runner, scenario, sim
 from pyins.sim.turntable import TableConfig
-from pyins.reference import attitude, earth
+from pyins.units import ARCSEC_TO_RAD as ARCSEC
+from pyins.units import DEG_TO_RAD as DEG
+from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
 
-DEG = earth.DEG_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
 PAPER = {1: (8.57, 3.70, 2.97), 2: (16.13, 12.90, 1.98)}
 SCHEMES = ((0, "no rotation"), (2, "traditional two-position"), (4, "flexible two-position"),
            (6, "flexible, derivation form"))        # the variants of the built-in seed002_exp* scenarios
@@ -51,18 +51,17 @@ PLANT_ACCEL = 1000.0 * DEG       # a motor that can follow PAPER_ACCEL
 
 
 def initial_errors(m):
-    """Seed 002 Table 1 errors applied to the true initial state."""
-    st = m.state(np.array([0.0]))
-    e = st.euler[0] + np.array([-10.0 * ARCSEC, 10.0 * ARCSEC, -60.0 * ARCSEC])  # heading +1' = yaw -1'
-    rm, rn = earth.principal_radii(np.sin(st.lat[0]))
-    return dict(euler_b_rad=e, vel_n_mps=[0.01, 0.01, 0.0],
-                lat_rad=st.lat[0] + 10.0 / rm, lon_rad=st.lon[0] + 10.0 / (rn * np.cos(st.lat[0])))
+    """Seed 002 Table 1 errors applied to the true initial state of ``m``
+    (`pyins.scenario.initial_errors`): pitch -10", roll 10", heading +1'
+    (yaw -1'), velocity 0.01 m/s east and north, position 10 m north and east."""
+    return scenario.initial_errors(m, pitch=-10.0 * ARCSEC, roll=10.0 * ARCSEC, yaw=-60.0 * ARCSEC,
+                                   velocity=[0.01, 0.01, 0.0], north=10.0, east=10.0)
 
 
 def error_sets():
     """The error sets run, name -> (SensorErrors, with Table 1 initial errors)."""
     t2 = sim.preset("seed002")
-    drift = 0.003 * earth.DPH_TO_RPS
+    drift = 0.003 * DPH_TO_RPS
     return {
         "table2": (t2, True),
         "hdrift": (sim.SensorErrors(gyro_bias=np.array([drift, drift, 0.0])), False),
@@ -84,14 +83,16 @@ def run_one(exp, scheme, sums, errors, with_init, accel, hours, seed):
         cfg["index_sums"] = sums
     if with_init:
         cfg.update(initial_errors(m))
-    res = fil.run_fil(m, int(hours * 360_000), config=cfg, errors=errors, seed=seed, every=100,
+    res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), config=cfg, errors=errors, seed=seed,
+                      every=TICK_HZ,
                       table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=fil.TextProgress())
     e = runner.nav_errors(res)
     psi = res.outputs["yaw_p_rad"]
-    # SPEC 1.10's proxy (from the 1 Hz records), split into the stopped and the turning part
+    # the proxy of docs/papers.md, seed 002 §10 (from the 1 Hz records), split into the stopped
+    # and the turning part
     stopped = np.asarray(res.outputs["index_state"]) != 2
-    return dict(final_nmi=float(e.horizontal_m[-1] / earth.NMI_TO_M),
-                max_nmi=float(e.horizontal_m.max() / earth.NMI_TO_M),
+    return dict(final_nmi=float(e.horizontal_m[-1] / NMI_TO_M),
+                max_nmi=float(e.horizontal_m.max() / NMI_TO_M),
                 survives=analysis.drift_surviving(psi),
                 survives_stops=analysis.drift_surviving(psi, stopped),
                 survives_turns=analysis.drift_surviving(psi, ~stopped),
@@ -133,7 +134,8 @@ def explain(r, hours):
                   "the heading; no scheme is designed against them.",
                   f"- **Horizontal drifts only** (the effect the paper's analysis is about): max "
                   f"{hd[0]:.3f} / {hd[1]:.3f} / {hd[2]:.3f} / {hd[3]:.3f} / {hd[4]:.3f} nmi; the "
-                  f"fraction of a constant x/y drift that survives (SPEC 1.10's proxy): "
+                  f"fraction of a constant x/y drift that survives (the proxy of docs/papers.md, "
+                  f"seed 002 §10): "
                   f"{' / '.join(f'{x:.4f}' for x in sv)}, of which the stopped ticks leave "
                   f"{' / '.join(f'{x:.4f}' for x in svs[1:])} and the turns "
                   f"{' / '.join(f'{x:.4f}' for x in svt[1:])} (the rotating schemes).",
@@ -151,16 +153,16 @@ def explain(r, hours):
                 f"- **The traditional scheme and the swing period lock** when the turns take "
                 f"exactly 30 s: a cycle is then 4 x 330 s = 1320 s = 11 swing periods, every cycle "
                 f"sees the swing at the same phases and a constant part of the drift survives "
-                f"({sv[1]:.4f}; SPEC 1.10 found 0.083 with the same ideal turns). With the "
+                f"({sv[1]:.4f}; docs/papers.md, seed 002 §10, found 0.083 with the same ideal turns). With the "
                 f"firmware's default 30 deg/s^2 each turn takes 0.2 s longer, the phase slips "
                 f"0.8 s per cycle, and over {hours:g} h the residue averages out: survival "
                 f"{sv30[1]:.4f}, max {hd30[1]:.3f} nmi instead of {hd[1]:.3f}. The paper's "
                 f"traditional result depends on this unstated detail.",
-                f"- **Flexible, literal vs derivation form**: the literal cycle (SPEC 1.6) turns a "
+                f"- **Flexible, literal vs derivation form**: the literal cycle (docs/papers.md, seed 002 §6) turns a "
                 f"variable angle and then a fixed 180 deg each way; even on a static ship those "
                 f"four turns leave (sin P2 - sin P0 - 2 sin P1)/omega of cos-integral per cycle "
                 f"(P0, P1, P2 its stop headings), where the traditional 0/180 turns leave none. "
-                f"Survival {sv[2]:.4f} (SPEC 1.10: 0.034{', the same' if abs(sv[2] - 0.034) < 0.002 else ''}), "
+                f"Survival {sv[2]:.4f} (docs/papers.md, seed 002 §10: 0.034{', the same' if abs(sv[2] - 0.034) < 0.002 else ''}), "
                 f"{svt[2]:.4f} of it from "
                 f"the turns. The derivation form (eqs. 9-13, no fixed 180-deg moves) "
                 f"leaves {sv[3]:.4f}. With the paper's turns the literal scheme beats the "
@@ -181,8 +183,8 @@ def explain(r, hours):
                 f"- **Why the traditional scheme does not fail here** (the paper: {p_tr:.2f} nmi, "
                 f"'basically fails'): the decoded swing has a 60 s period, and every 300-s stop "
                 f"covers exactly 5 periods, so the x/y drift cancels almost perfectly "
-                f"(survival {sv[1]:.4f}, {hd[1]:.3f} nmi with horizontal drifts only; SPEC 1.7 and "
-                f"1.10 predicted this). The paper's text says the swing period equals the stop "
+                f"(survival {sv[1]:.4f}, {hd[1]:.3f} nmi with horizontal drifts only; docs/papers.md, seed 002 §7 "
+                f"and §10 predicted this). The paper's text says the swing period equals the stop "
                 f"time, which the decoded formula does not give; nothing was changed to match.",
                 f"- **With all errors**: ours {tr:.2f} (traditional) and {fl:.2f} / {fd:.2f} / "
                 f"{fa:.2f} nmi (flexible, literal / derivation / derivation with turns summed) "
@@ -263,7 +265,7 @@ def main(argv=None):
                 print(md[-1], flush=True)
                 if acc == "paper" and es in ("table2", "hdrift"):
                     row = 0 if es == "table2" else 1
-                    ax[row, col].plot(e.time_s / 3600, e.horizontal_m / earth.NMI_TO_M, label=label)
+                    ax[row, col].plot(e.time_s / 3600, e.horizontal_m / NMI_TO_M, label=label)
                     ax[row, col].set_title(f"experiment {exp}, {SET_LABEL[es]}", fontsize=9)
                     ax[row, col].set_ylabel("horizontal error [nmi]")
     for a in ax.flat:

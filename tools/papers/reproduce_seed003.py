@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Reproduce seed 003 (single-position forward/reverse rotate-stop, 24 h).
 
-    .venv/bin/python tools/reproduce_seed003.py [--out runs/seed003]
+    .venv/bin/python tools/papers/reproduce_seed003.py [--out runs/seed003]
 
-Static ship, 24 h, seed 003's sensor errors (SPEC 4.3: drift 0.003 deg/h,
-ARW 0.0005 deg/sqrt(h), gyro SF 0.466 ppm, accelerometer bias 20 ug and
+Static ship, 24 h, seed 003's sensor errors (docs/papers.md, seed 003 §3:
+drift 0.003 deg/h, ARW 0.0005 deg/sqrt(h), gyro SF 0.466 ppm, accelerometer bias 20 ug and
 SF 20 ppm, the +-2" installation matrix on both triads), the firmware
 started from the true state, the IMU either fixed (no rotation) or indexed
 by the single-position scheme (stop 60 s at zero, +360 deg at 6 deg/s, stop,
@@ -23,17 +23,17 @@ import sys
 import numpy as np
 
 from pyins import analysis, fil, runner, sim
-from pyins.reference import earth
+from pyins.units import ARCMIN_TO_RAD as ARCMIN
+from pyins.units import DEG_TO_RAD as DEG
+from pyins.units import NMI_TO_M, TICK_HZ
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
 PAPER = {"position_nmi": 1.1, "level_arcmin": 0.01, "heading_arcmin": 0.3, "velocity_mps": 0.06}
 
 
 def figures(err):
     """The paper's four maxima from a NavErrors or StaticErrors."""
     return {
-        "position_nmi": err.horizontal_m.max() / earth.NMI_TO_M,
+        "position_nmi": err.horizontal_m.max() / NMI_TO_M,
         "level_arcmin": np.abs(err.att_n_rad[:, :2]).max() / ARCMIN,
         "heading_arcmin": np.abs(err.att_n_rad[:, 2]).max() / ARCMIN,
         "velocity_mps": np.abs(err.vel_n_mps[:, :2]).max(),
@@ -54,7 +54,7 @@ def main(argv=None):
     lat = 34.246 * DEG
     m = sim.Static(lat, 108.91 * DEG, 0.0)
     errors = sim.preset("seed003")
-    ticks = int(args.hours * 360_000)
+    ticks = int(args.hours * (3600 * TICK_HZ))
     grid = np.arange(1, int(args.hours * 12) + 1) * 300.0       # the linear model every 5 min
     fig_json = {"hours": args.hours, "latitude_deg": 34.246}
     rows = []
@@ -63,7 +63,7 @@ def main(argv=None):
     up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
     for scheme, label in ((0, "no rotation"), (1, "single-position fwd/rev (seed 003)")):
         res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed,
-                          every=100, progress=fil.TextProgress())
+                          every=TICK_HZ, progress=fil.TextProgress())
         e = runner.nav_errors(res)
         # error theory with the same constant drifts and biases, and split by source
         theory = {
@@ -78,7 +78,7 @@ def main(argv=None):
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_max_{k}"] = float(v)
         # the same run with the constant drifts and biases only: what theory covers
-        res_b = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), seed=args.seed, every=100,
+        res_b = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), seed=args.seed, every=TICK_HZ,
                             errors=sim.SensorErrors(gyro_bias=errors.gyro_bias,
                                                     accel_bias=errors.accel_bias))
         rows.append((f"ours, {label}, constant drifts and biases only", figures(runner.nav_errors(res_b))))
@@ -89,8 +89,8 @@ def main(argv=None):
             for k, v in rows[-1][1].items():
                 fig_json[f"{tag}_theory_{what.split()[0].replace('-', '_')}_max_{k}"] = float(v)
         th = e.time_s / 3600
-        ax[0].plot(th, e.horizontal_m / earth.NMI_TO_M, label=label)
-        ax[0].plot(grid / 3600, theory["all constant errors"].horizontal_m / earth.NMI_TO_M, ":",
+        ax[0].plot(th, e.horizontal_m / NMI_TO_M, label=label)
+        ax[0].plot(grid / 3600, theory["all constant errors"].horizontal_m / NMI_TO_M, ":",
                    label=f"error theory, {label}")
         ax[1].plot(th, np.abs(e.att_n_rad[:, :2]).max(axis=1) / ARCMIN, label=label)
         ax[2].plot(th, e.att_n_rad[:, 2] / ARCMIN, label=label)

@@ -1,0 +1,89 @@
+// config.hpp: the configuration contract, apart from the instance.
+//
+// Mirrored by pyins/reference/config.py. A pyins_config field left 0 means
+// "the default": (1) the defaults, one table; (2) config_default, the
+// zeroed struct; (3) config_resolved, the defaults put in; (4) config_check,
+// PYINS_OK or the first PYINS_E_CONFIG_* status that applies. pyins_init
+// checks everything before it changes any state (c_api.cpp); the instance
+// (firmware.hpp) takes a checked configuration and resolves it.
+#pragma once
+
+#include <cstdint>
+
+#include "pyins_core.h"
+#include "units.hpp"
+
+namespace pyins::config {
+
+// --- 1. the defaults, and the limits the checks hold a configuration to ------
+inline constexpr int32_t kDefaultTickHz = 100;
+inline constexpr int32_t kMaxTickHz = 10000;
+/// The ENU frame is singular at the poles: latitudes beyond this are refused.
+inline constexpr double kMaxLatRad = 89.9 * kPi / 180.0;
+/// Coarse alignment defaults, in seconds (seed 000: first output 20 s, then 1 s).
+inline constexpr int32_t kDefaultCoarseFirstS = 20;
+inline constexpr int32_t kDefaultCoarseEveryS = 1;
+inline constexpr double kDefaultCoarseRatio = 0.5;
+/// Fine alignment defaults (seed 001 sec. 3.3; docs/papers.md, seed 001 §3).
+inline constexpr int32_t kDefaultFineStates = 5;
+inline constexpr int32_t kDefaultFineMeasEvery = 10;             ///< 10 Hz updates at 100 Hz
+inline constexpr int32_t kDefaultMovingMeasEverySecond = 1;      ///< moving base: 1 Hz position updates
+inline constexpr double kDefaultPosSigma = 0.5;                  ///< [m]: a moored ship's surge and sway
+inline constexpr double kDefaultSigma0Vel = 0.5;                 ///< [m/s]: its wave velocity at the start
+inline constexpr double kDefaultFineArw = 0.001 * kDegToRad / 60.0;  ///< 0.001 deg/sqrt(h)
+inline constexpr double kDefaultFineVrw = 10.0e-6 * kG0;   ///< 10 ug/sqrt(Hz)
+inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminToRad, 100.0 * kArcminToRad,
+                                                   600.0 * kArcminToRad};  ///< 10 x [10', 10', 60']
+/// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
+/// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
+/// tools/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
+/// heading let the wave noise swing the early heading by 80' (measured).
+inline constexpr double kDefaultMovingSigmaAtt[3] = {1.0 * kArcminToRad, 1.0 * kArcminToRad,
+                                                     10.0 * kArcminToRad};
+inline constexpr double kDefaultFineSigmaGyro = 0.01 * kDegToRad / 3600.0;
+inline constexpr double kDefaultFineSigmaAccel = 100.0e-6 * kG0;  ///< 100 ug (not in seed 001)
+/// Indexing defaults (seeds 002, 003: 6 deg/s; stops 60 s in seed 003, 300 s in seed 002).
+inline constexpr double kDefaultIndexRate = 6.0 * kDegToRad;
+inline constexpr double kDefaultIndexAccel = 30.0 * kDegToRad;     ///< not in the papers
+inline constexpr double kDefaultIndexDelta = 0.01;            ///< seed 002, at 100 Hz
+inline constexpr double kDefaultIndexMaxFlex = 720.0 * kDegToRad;  ///< two turns: the ship may turn back
+inline constexpr double kDefaultIndexTolerance = 0.5 * kDegToRad;
+inline constexpr double kDefaultIndexJump = 5.0 * kDegToRad;
+inline constexpr int32_t kDefaultIndexTimeoutS = 2;
+inline constexpr int32_t kDefaultStopSeed003S = 60;
+inline constexpr int32_t kDefaultStopS = 300;
+/// Sample-level faults (docs/core.md). Saturation defaults: 400 deg/s and
+/// 20 g per axis, the order of a navigation-grade RLG IMU's range (the
+/// issue's figures); a ship stays far below (seed 000's bad sea state peaks
+/// at 23 deg/s and 0.3 g beyond gravity), so only a saturated sensor (a
+/// shock) or a corrupted word reaches them.
+inline constexpr double kDefaultSatGyroRate = 400.0 * kDegToRad;      ///< [rad/s]
+inline constexpr double kDefaultSatAccel = 20.0 * kG0;       ///< [m/s^2]
+/// Longest gap bridged by interpolation [ticks]; see docs/core.md for the
+/// error it leaves on seed 000's bad sea state.
+inline constexpr int32_t kDefaultSeqMaxGap = 2;
+/// Upper bound of seq_max_gap_ticks: one step call bridges at most this many
+/// ticks (its worst-case run time is that many strapdown updates).
+inline constexpr int32_t kMaxSeqGap = 100;
+/// Longest lever arm accepted [m]: a ship's IMU is metres from its reference
+/// point; beyond 100 m the number is a unit mistake (mm or inches).
+inline constexpr double kMaxLeverM = 100.0;
+/// Integrity defaults (docs/concepts.md, "Integrity"): 100 updates (10 s at
+/// 10 Hz) per NIS window and a bound of 4 on its mean (10 sigma of a
+/// consistent window); the coarse solution may wander 30' over its last
+/// fifth (measured on the moored ship with seed 000's errors: FIT over 120 s
+/// wanders 2.7-10.9', over 300 s < 1.5'; TRIAD over 300 s 164-326').
+inline constexpr int32_t kDefaultNisWindow = 100;
+inline constexpr double kDefaultNisMax = 4.0;
+inline constexpr double kDefaultCoarseWander = 30.0 * kArcminToRad;
+
+/// 2. Fill *cfg with the defaults (equal to a zeroed config).
+void config_default(pyins_config* cfg);
+
+/// 3. The configuration with every zero-means-default field resolved.
+pyins_config config_resolved(const pyins_config& cfg);
+
+/// 4. PYINS_OK or the first PYINS_E_CONFIG_* that applies.
+int config_check(const pyins_config& cfg);
+
+}  // namespace pyins::config

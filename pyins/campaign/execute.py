@@ -1,0 +1,247 @@
+"""Running a campaign: its missing runs, on a local process pool or a Dask cluster.
+
+Runs are content addressed: point ``p`` runs with `pyins.runs.execute` into
+``OUT/<p.dir>`` = ``OUT/runs/<digest[:16]>``, so a campaign that is run
+again (after a kill, a Ctrl-C, or with more seeds) runs only what has no
+complete summary.json of that digest (`pending`). Each run writes only its
+own directory, its summary.json last and atomically, so a kill loses at
+most the runs in flight.
+
+Execution: a local process pool using every core (``workers``), or a Dask
+distributed cluster (``scheduler``: its address, or a ``distributed.Client``)
+whose workers see ``out_dir`` at the same path (one machine, or a shared
+file system) and have the same pyins installed; dask is imported only then.
+
+`run_campaign`:
+1. the runs with no complete summary.json (`pending`), and campaign.json
+   marked "running";
+2. every missing run (`_run_point`: rebuild the scenario from the base's data
+   and the overrides, check its digest, run it), locally or on Dask, each
+   recorded as it finishes or fails;
+3. the aggregates (`pyins.campaign.aggregate`), and campaign.json with what
+   was computed, skipped or failed.
+"""
+import copy
+import json
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+
+from pyins import runs
+from pyins import scenario as scenario_mod
+from pyins.campaign.aggregate import aggregate, plan, read_summary, write_json
+
+__all__ = ["CampaignError", "run_campaign", "pending", "DASK_CONNECT_TIMEOUT"]
+
+DASK_CONNECT_TIMEOUT = "20s"   #: how long to wait for a Dask scheduler
+
+
+class CampaignError(RuntimeError):
+    """A campaign that cannot run (no dask, no scheduler) or whose runs
+    failed (``result``: the campaign.json written with what did finish)."""
+
+    def __init__(self, message, result=None):
+        super().__init__(message)
+        self.result = result
+
+
+def _is_done(run_dir, digest):
+    s = read_summary(run_dir)
+    return s is not None and s.get("complete") is True and s.get("digest") == digest
+
+
+def _run_point(task):
+    """Run one point into its run directory (in a pool process or on a Dask
+    worker): rebuild the scenario from the base's data and the overrides,
+    check its digest, `pyins.runs.execute` it (resume=True: an earlier
+    killed attempt continues from its checkpoint). Returns
+    {"digest", "wall_s", "summary"}."""
+    t0 = time.perf_counter()
+    base = scenario_mod.Scenario(task["text"], copy.deepcopy(task["data"]), task["source"], task["stem"])
+    scn = base.with_overrides(task["overrides"])
+    digest = scn.digest()
+    if digest != task["digest"]:
+        raise CampaignError(f"this worker's pyins resolves the scenario differently (digest "
+                            f"{digest[:16]}, not {task['digest'][:16]}): install the same pyins on "
+                            f"every worker")
+    run_dir = task["run_dir"]
+    os.makedirs(run_dir, exist_ok=True)
+    point_json = os.path.join(run_dir, "point.json")
+    if os.path.exists(point_json):
+        with open(point_json) as f:
+            old = json.load(f)
+        if old.get("digest") != digest:
+            raise CampaignError(f"{run_dir} belongs to another scenario (digest {old.get('digest')})")
+    else:
+        write_json(point_json, {"digest": digest, "base": base.name, "base_source": str(task["source"]),
+                                "overrides": task["overrides"]})
+    try:
+        summary = runs.execute(scn, run_dir, resume=True)
+    except ValueError as exc:
+        if "checkpoint belongs to another run" not in str(exc):
+            raise
+        summary = runs.execute(scn, run_dir, resume=False)   # a checkpoint of an older pyins
+    return {"digest": digest, "wall_s": time.perf_counter() - t0, "summary": summary}
+
+
+def pending(camp, out_dir):
+    """The digests (in point order, each once) of the runs of ``camp`` that
+    have no complete summary.json in ``out_dir``, and how many runs it has."""
+    seen, todo = set(), []
+    for p in camp.points:
+        if p.digest in seen:
+            continue
+        seen.add(p.digest)
+        if not _is_done(os.path.join(out_dir, p.dir), p.digest):
+            todo.append(p.digest)
+    return todo, len(seen)
+
+
+def _tasks(camp, out_dir, digests):
+    by_digest = {}
+    for p in camp.points:
+        by_digest.setdefault(p.digest, p)
+    data = camp.base.data
+    out = []
+    for d in digests:
+        p = by_digest[d]
+        out.append({"text": camp.base.text, "data": data, "source": camp.base.source,
+                    "stem": getattr(camp.base, "_stem", camp.base.name), "overrides": p.overrides,
+                    "digest": d, "run_dir": os.path.abspath(os.path.join(out_dir, p.dir)),
+                    "label": p.label(camp.labels)})
+    return out
+
+
+def _first_line(exc):
+    text = f"{type(exc).__name__}: {exc}"
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def _run_local(tasks, workers, on_done):
+    if workers == 1:
+        for t in tasks:
+            try:
+                on_done(t, _run_point(t), None)
+            except KeyboardInterrupt:
+                raise
+            except Exception as exc:             # noqa: BLE001 - recorded, the others go on
+                on_done(t, None, exc)
+        return "local, in process"
+    ex = ProcessPoolExecutor(max_workers=workers)
+    futs = {}
+    try:
+        futs = {ex.submit(_run_point, t): t for t in tasks}
+        for f in as_completed(futs):
+            exc = f.exception()
+            on_done(futs[f], None if exc else f.result(), exc)
+    except BaseException:
+        for f in futs:
+            f.cancel()
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
+    return f"local process pool, {workers} worker(s)"
+
+
+def _run_dask(tasks, scheduler, on_done):
+    try:
+        import distributed
+    except ImportError:
+        raise CampaignError("running on a Dask cluster needs dask.distributed: "
+                            "pip install 'pyins[campaign]' (or \"dask[distributed]\")") from None
+    own = not isinstance(scheduler, distributed.Client)
+    if own:
+        try:
+            client = distributed.Client(scheduler, timeout=DASK_CONNECT_TIMEOUT)
+        except (OSError, TimeoutError) as exc:
+            raise CampaignError(f"cannot connect to the Dask scheduler {scheduler}: "
+                                f"{_first_line(exc)}") from None
+    else:
+        client = scheduler
+    try:
+        address = client.scheduler.address
+        futs = client.map(_run_point, tasks, pure=False)
+        index = {f.key: t for f, t in zip(futs, tasks)}
+        try:
+            for f in distributed.as_completed(futs):
+                if f.status == "error":
+                    on_done(index[f.key], None, f.exception())
+                else:
+                    on_done(index[f.key], f.result(), None)
+                f.release()
+        except BaseException:
+            client.cancel(futs)
+            raise
+    finally:
+        if own:
+            client.close()
+    return f"dask {address}"
+
+
+def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log=None, plots=True):
+    """Run the campaign's missing runs into ``out_dir`` and aggregate.
+
+    ``workers``: processes of the local pool (default os.cpu_count(); 1 runs
+    in this process); ``scheduler``: a Dask scheduler address
+    ("tcp://host:8786") or a ``distributed.Client``, instead of the local
+    pool. ``progress(done, total, skipped)`` is called once before running
+    (done = skipped: the runs found complete) and after every run;
+    ``log(line)`` gets a line per finished or failed run. Returns the
+    campaign.json dict (its ``execution`` entry says what was computed,
+    skipped or failed, and the wall time: everything else is the same
+    whichever way and in however many pieces the campaign ran). If runs
+    failed, every result is still written and CampaignError is raised
+    (``.result``: that dict).
+    """
+    t0 = time.perf_counter()
+    out_dir = str(out_dir)
+    os.makedirs(os.path.join(out_dir, "runs"), exist_ok=True)
+    # 1. what is missing
+    todo, total = pending(camp, out_dir)
+    skipped = total - len(todo)
+    write_json(os.path.join(out_dir, "campaign.json"),
+               dict(plan(camp), complete=False, note="running: aggregates are written at the end"))
+    if progress:
+        progress(skipped, total, skipped)
+    state = {"done": skipped, "computed": 0, "failed": []}
+    tasks = _tasks(camp, out_dir, todo)
+
+    def on_done(task, result, exc):
+        state["done"] += 1
+        if exc is not None:
+            state["failed"].append({"digest": task["digest"], "label": task["label"],
+                                    "error": _first_line(exc)})
+            if log:
+                log(f"  FAILED {task['label']}: {_first_line(exc)}")
+        else:
+            state["computed"] += 1
+            if not os.path.exists(os.path.join(task["run_dir"], "summary.json")):
+                # a Dask worker without the shared file system: keep its summary here
+                os.makedirs(task["run_dir"], exist_ok=True)
+                write_json(os.path.join(task["run_dir"], "summary.json"), result["summary"])
+            if log:
+                log(f"  {task['label']}: {result['wall_s']:.2f} s")
+        if progress:
+            progress(state["done"], total, skipped)
+
+    # 2. run it, locally or on Dask
+    how = "nothing to run"
+    if tasks:
+        if scheduler is not None:
+            how = _run_dask(tasks, scheduler, on_done)
+        else:
+            n = workers or os.cpu_count() or 1
+            how = _run_local(tasks, max(1, min(n, len(tasks))), on_done)
+    # 3. the aggregates
+    result = aggregate(camp, out_dir, plots=plots)
+    result["execution"] = {"scheduler": how, "runs": total, "computed": state["computed"],
+                           "skipped": skipped, "failed": state["failed"],
+                           "wall_s": time.perf_counter() - t0}
+    write_json(os.path.join(out_dir, "campaign.json"), result)
+    if state["failed"]:
+        f = state["failed"][0]
+        raise CampaignError(f"{len(state['failed'])} of {total} runs failed (first: {f['label']}: "
+                            f"{f['error']}); the results cover the others. Run the campaign again "
+                            f"to retry them.", result)
+    return result
+

@@ -1,0 +1,95 @@
+"""The engine choice: the compiled firmware or its NumPy reference mirror,
+behind one contract.
+
+``engine="native"`` runs the C++ core (`pyins.native.Firmware`) and, in a
+closed loop, the compiled plant (`pyins.native.Plant`); ``"reference"`` runs
+the NumPy mirror of the core (`pyins.reference.Firmware`, the same
+constructor, ``step``, ``run``, ``snapshot``/``restore`` and records of
+``native.OUTPUT_DTYPE``) and the NumPy mirror of the plant (`MirrorPlant`,
+over `pyins.sim.turntable`), about a thousand times slower. Everything above
+(runner, fil, runs, the CLI's ``--engine``) is the same code for both.
+"""
+import json
+
+import numpy as np
+
+from pyins import native, reference
+from pyins.sim import turntable
+
+ENGINES = ("native", "reference")
+_FIRMWARE = {"native": native.Firmware, "reference": reference.Firmware}
+
+
+def check(engine):
+    """``engine`` if it is one of ENGINES, else ValueError."""
+    if engine not in _FIRMWARE:
+        raise ValueError(f"engine: {engine!r} is not one of {', '.join(ENGINES)}")
+    return engine
+
+
+def firmware(engine, config):
+    """A firmware instance of ``engine`` from a configuration dict."""
+    return _FIRMWARE[check(engine)](config)
+
+
+def plant(engine, table, errors, record_dtype, alpha0=0.0):
+    """The closed loop's plant of ``engine``: ``table`` a TableConfig,
+    ``errors`` the plant's error matrices (turntable.error_matrices)."""
+    if check(engine) == "native":
+        return native.Plant(table, errors, record_dtype, alpha0)
+    return MirrorPlant(table, errors, record_dtype, alpha0)
+
+
+class MirrorPlant:
+    """`pyins.native.Plant`'s contract over the NumPy plant mirror: one
+    ``turntable.plant_tick`` and one firmware ``step`` per tick, in the order
+    of ``pyins_fil_run`` (csrc/plant/plant.cpp)."""
+
+    def __init__(self, table, errors, record_dtype, alpha0=0.0):
+        self._table, self._errors, self._record_dtype = table, errors, record_dtype
+        self._st = turntable.PlantState(alpha_rad=float(alpha0))
+
+    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every):
+        """As `pyins.native.Plant.run`."""
+        st = self._st
+        tick0 = st.tick
+        outs, recs = [], []
+        for k in range(n):
+            # 1. the plant: motor, turning IMU, sensor errors, encoder
+            b = (phase0 + k) % period
+            g, a, enc, seq = turntable.plant_tick(
+                self._table, st, self._errors, omega[b], force[b], x, w,
+                None if gyro_noise is None else gyro_noise[k],
+                None if accel_noise is None else accel_noise[k], dt)
+            # 2. the firmware's tick, and its motor command back to the plant
+            try:
+                out = fw.step(g, a, enc, seq)
+            except native.SampleError as exc:
+                raise native.PlantError(exc.code, f"pyins_fil_run at tick {tick0 + k}", k,
+                                        self._kept(outs, native.OUTPUT_DTYPE),
+                                        self._kept(recs, self._record_dtype)) from None
+            st.rate_cmd_rad_s = float(out["motor_rate_cmd_rad_s"])
+            # 3. the kept records
+            if st.tick % every == 0:
+                outs.append(out)
+                recs.append((st.tick, st.alpha_rad, st.rate_rad_s, enc))
+        return self._kept(outs, native.OUTPUT_DTYPE), self._kept(recs, self._record_dtype)
+
+    @staticmethod
+    def _kept(rows, dtype):
+        return np.array(rows, dtype=dtype) if rows else np.zeros(0, dtype=dtype)
+
+    def snapshot(self):
+        """The plant state as bytes (JSON: exact for every float)."""
+        st = self._st
+        return json.dumps(dict(tick=st.tick, alpha_rad=st.alpha_rad, rate_rad_s=st.rate_rad_s,
+                               rate_cmd_rad_s=st.rate_cmd_rad_s,
+                               gyro_residual=list(map(float, st.gyro_residual)),
+                               accel_residual=list(map(float, st.accel_residual)))).encode()
+
+    def restore(self, blob):
+        d = json.loads(bytes(blob).decode())
+        self._st = turntable.PlantState(
+            tick=d["tick"], alpha_rad=d["alpha_rad"], rate_rad_s=d["rate_rad_s"],
+            rate_cmd_rad_s=d["rate_cmd_rad_s"], gyro_residual=np.array(d["gyro_residual"]),
+            accel_residual=np.array(d["accel_residual"]))

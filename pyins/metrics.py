@@ -1,0 +1,299 @@
+"""The metrics: what a run (or a group of runs) scored, one table.
+
+Every metric the project computes, prints or compares with a paper is one
+row of `TABLE`, in the manner of nmayorov/pyins's per-quantity threshold
+table: its name, dimension (a `pyins.units` dimension), SI unit, the unit the
+papers write it in (and the scale from SI), what it means and the function
+that computes it. The order of the table is the order metrics are listed in
+(summary.json, campaign tables, the report).
+
+Two scopes:
+
+- "run": one run's records against its truth (`run_metrics`). They are
+  computed in stages: "nav" for every run with records, "alignment" when the
+  firmware aligns (the theoretical limit of an alignment, seed 001 eq. 21),
+  "static_fine" when a fine alignment runs on a static base (seed 001: the
+  filter's errors beside the limits).
+- "group": over the runs of one scenario or campaign group (seeds,
+  headings): seed 000's Table 1 std (`group_metrics`).
+
+`display(name, values_si)` is the unit a metric is shown in: arcsec for
+level errors, arcmin for heading errors, m or nmi for positions (nmi when
+the values reach half a nautical mile).
+
+Steps of a run's metrics:
+1. the navigation errors against the truth (`nav_errors`);
+2. the nav stage, every run;
+3. the alignment stage, against the limit at the final true attitude;
+4. the static fine-alignment stage, the filter's drift estimate beside the
+   limit at t = 0.
+"""
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Callable
+
+import numpy as np
+
+from pyins import analysis, sim
+from pyins.reference import attitude, earth
+from pyins.reference.fine_align import EPS, EPS_NU
+from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, NMI_TO_M, TWO_PI, UNITS)
+
+__all__ = ["Metric", "TABLE", "NAMES", "FIGURE_METRICS", "RUN_METRICS", "GROUP_METRICS", "NavErrors",
+           "nav_errors", "run_metrics", "group_metrics", "info", "dimension", "describe", "si_unit",
+           "si_name", "display"]
+
+
+# ---------------------------------------------------------------------------
+# 1. Navigation errors against the truth
+# ---------------------------------------------------------------------------
+@dataclass
+class NavErrors:
+    """Errors of the firmware against the truth at each kept tick."""
+    time_s: np.ndarray       #: ship time [s]
+    north_m: np.ndarray      #: position error, north [m]
+    east_m: np.ndarray       #: position error, east [m]
+    horizontal_m: np.ndarray  #: horizontal position error [m]
+    vel_n_mps: np.ndarray    #: velocity error, ENU (N, 3) [m/s]
+    att_n_rad: np.ndarray    #: attitude error phi in n (E, N, U) (N, 3) [rad]:
+    #:                          C_b^n(computed) = (I - phi x) C_b^n(true)
+
+
+def nav_errors(result):
+    """Position, velocity and attitude errors of a result with ``outputs``
+    (firmware records), ``truth`` (pyins.sim.Truth at the same ticks) and
+    ``dt`` (a runner.RunResult or a fil.FilResult)."""
+    out, tr = result.outputs, result.truth
+    lat_t = tr.lat
+    rm, rn = earth.principal_radii(np.sin(lat_t))
+    north = (out["lat_rad"] - lat_t) * (rm + tr.height)
+    dlon = np.mod(out["lon_rad"] - tr.lon + np.pi, TWO_PI) - np.pi
+    east = dlon * (rn + tr.height) * np.cos(lat_t)
+    att = np.empty((len(out), 3))
+    for k in range(len(out)):
+        # q_err = q_nb(computed) (x) conj(q_nb(true)) = rotation by -phi in n
+        q_err = attitude.quat_mul(out["quat_nb"][k], attitude.quat_conj(tr.quat_nb[k]))
+        att[k] = -attitude.quat_to_rotvec(attitude.quat_normalize(q_err))
+    return NavErrors(time_s=out["tick"] * result.dt, north_m=north, east_m=east,
+                     horizontal_m=np.hypot(north, east), vel_n_mps=out["vel_n_mps"] - tr.vel_n,
+                     att_n_rad=att)
+
+
+class _Run:
+    """What the run metrics read: the errors of one run and, when a stage
+    needs them, the alignment limits (computed once)."""
+
+    def __init__(self, spec, res):
+        self.spec, self.res = spec, res
+        self.err = nav_errors(res)
+        self.att = self.err.att_n_rad
+        self.level = np.abs(self.att[:, :2]).max(axis=1)
+
+    @cached_property
+    def final_limits(self):
+        """The alignment limits at the final true attitude (seed 001 eq. 21)."""
+        return analysis.alignment_limits(float(self.res.truth.lat[-1]), self.res.truth.euler[-1],
+                                         self.spec.errors.gyro_bias, self.spec.errors.accel_bias)
+
+    @cached_property
+    def vs_limit(self):
+        """phi at the end minus its limit."""
+        return self.att[-1] - self.final_limits.phi_n
+
+    @cached_property
+    def start_limits(self):
+        """The limits of the static base at t = 0 (seed 001)."""
+        st = self.spec.motion.state(np.array([0.0]))
+        return analysis.alignment_limits(float(st.lat[0]), st.euler[0], self.spec.errors.gyro_bias,
+                                         self.spec.errors.accel_bias)
+
+    @cached_property
+    def drift_error(self):
+        """True minus estimated drift in n at the end [E, N, U] (the 5-state
+        filter estimates no eps_E: taken as 0)."""
+        kf_x = self.res.outputs["kf_x"]
+        if self.spec.config.get("fine_states", 8) == 5:
+            eps = np.concatenate([[0.0], kf_x[-1, EPS_NU]])
+        else:
+            eps = np.asarray(kf_x[-1, EPS])
+        return self.start_limits.eps_n - eps
+
+
+def _std(variants):
+    """Sample std (ddof 1) of the final [phi_E, phi_N, phi_U] over the
+    variants, or None with fewer than two."""
+    finals = np.array([[v["metrics"][k] for k in ("phi_e_final", "phi_n_final", "phi_u_final")]
+                       for v in variants if "phi_e_final" in v["metrics"]])
+    return finals.std(axis=0, ddof=1) if len(finals) >= 2 else None
+
+
+# ---------------------------------------------------------------------------
+# The table
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Metric:
+    """One metric. ``unit``/``scale``: the papers' unit and its size in SI
+    (value shown = value_si / scale); ``figure``: a [paper] figure may name
+    it; ``stage``: when a run computes it (see the module docstring);
+    ``compute``: the function (a run's `_Run` -> float; group: the
+    variants' summary entries -> float, given at least two)."""
+    name: str
+    dimension: str
+    unit: str
+    scale: float
+    description: str
+    scope: str
+    stage: str
+    figure: bool
+    compute: Callable
+
+    @property
+    def si_unit(self):
+        return next(iter(UNITS[self.dimension])) if self.dimension in UNITS else ""
+
+
+def _m(name, dimension, unit, scale, description, compute, stage="nav", figure=True):
+    scope = "group" if stage == "group" else "run"
+    return Metric(name, dimension, unit, scale, " ".join(description.split()), scope, stage, figure,
+                  compute)
+
+
+_M, _ARCSEC, _ARCMIN = 1.0, ARCSEC_TO_RAD, ARCMIN_TO_RAD
+TABLE = (
+    _m("horizontal_error_final", "length", "m", _M,
+       "horizontal position error at the end of the run",
+       lambda r: float(r.err.horizontal_m[-1])),
+    _m("horizontal_error_max", "length", "m", _M,
+       "largest horizontal position error over the run",
+       lambda r: float(r.err.horizontal_m.max())),
+    _m("level_error_final", "angle", "arcsec", _ARCSEC,
+       "larger of |phi_E|, |phi_N| at the end of the run",
+       lambda r: float(r.level[-1])),
+    _m("level_error_max", "angle", "arcsec", _ARCSEC,
+       "largest |phi_E|, |phi_N| over the run",
+       lambda r: float(r.level.max())),
+    _m("heading_error_final", "angle", "arcmin", _ARCMIN,
+       "|phi_U| at the end of the run",
+       lambda r: float(abs(r.att[-1, 2]))),
+    _m("heading_error_max", "angle", "arcmin", _ARCMIN,
+       "largest |phi_U| over the run",
+       lambda r: float(np.abs(r.att[:, 2]).max())),
+    _m("velocity_error_max", "velocity", "m/s", 1.0,
+       "largest horizontal velocity error component over the run",
+       lambda r: float(np.abs(r.err.vel_n_mps[:, :2]).max())),
+    _m("level_error_std", "angle", "arcsec", _ARCSEC,
+       "std of the final pitch and roll errors over the runs of a campaign (seeds, headings)",
+       lambda vs: float(_std(vs)[:2].max()), stage="group"),
+    _m("heading_error_std", "angle", "arcmin", _ARCMIN,
+       "std of the final heading error over the runs of a campaign",
+       lambda vs: float(_std(vs)[2]), stage="group"),
+    _m("level_error_vs_limit_final", "angle", "arcsec", _ARCSEC,
+       "larger of |phi_E - limit|, |phi_N - limit| at the end (alignment: against the theoretical "
+       "limit, which any alignment shares)",
+       lambda r: float(np.abs(r.vs_limit[:2]).max()), stage="alignment"),
+    _m("heading_error_vs_limit_final", "angle", "arcmin", _ARCMIN,
+       "|phi_U - limit| at the end (alignment)",
+       lambda r: float(abs(r.vs_limit[2])), stage="alignment"),
+    _m("att_east_gap_final", "angle", "arcmin", _ARCMIN,
+       "|phi_E error - theoretical limit| at the end (alignment)",
+       lambda r: float(abs(r.att[-1, 0] - r.start_limits.phi_n[0])), stage="static_fine"),
+    _m("att_up_gap_final", "angle", "arcmin", _ARCMIN,
+       "|phi_U error - theoretical limit| at the end (alignment)",
+       lambda r: float(abs(r.att[-1, 2] - r.start_limits.phi_n[2])), stage="static_fine"),
+    _m("drift_north_gap_final", "angular_rate", "deg/h", DPH_TO_RPS,
+       "|eps_N estimate error - limit| at the end (fine alignment)",
+       lambda r: float(abs(r.drift_error[1] - r.start_limits.eps_n_limit[1])), stage="static_fine"),
+    _m("phi_e_final", "angle", "arcsec", _ARCSEC,
+       "phi_E (east attitude error) at the end of the run",
+       lambda r: float(r.att[-1, 0]), figure=False),
+    _m("phi_n_final", "angle", "arcsec", _ARCSEC,
+       "phi_N (north attitude error) at the end of the run",
+       lambda r: float(r.att[-1, 1]), figure=False),
+    _m("phi_u_final", "angle", "arcmin", _ARCMIN,
+       "phi_U (up attitude error, heading) at the end of the run",
+       lambda r: float(r.att[-1, 2]), figure=False),
+)
+_BY_NAME = {m.name: m for m in TABLE}
+NAMES = tuple(_BY_NAME)                                            #: every metric, in order
+FIGURE_METRICS = tuple(m.name for m in TABLE if m.figure)           #: what [paper] figures name
+RUN_METRICS = tuple(m.name for m in TABLE if m.scope == "run")
+GROUP_METRICS = tuple(m.name for m in TABLE if m.scope == "group")
+_STAGES = ("nav", "alignment", "static_fine")
+
+
+# ---------------------------------------------------------------------------
+# 2-4. Computing them
+# ---------------------------------------------------------------------------
+def _stages(spec):
+    """The stages of run metrics ``spec`` (a pyins.scenario.RunSpec) computes."""
+    yield "nav"
+    if spec.config.get("coarse_ticks", 0) or spec.config.get("fine_ticks", 0):
+        yield "alignment"
+    if spec.config.get("fine_ticks", 0) and isinstance(spec.motion, sim.Static):
+        yield "static_fine"
+
+
+def run_metrics(spec, res):
+    """The run metrics of one run (SI units): ``res`` holds its records
+    and truth (a fil.FilResult); {} when it has no records."""
+    if len(res.outputs) == 0:
+        return {}
+    run = _Run(spec, res)                                            # 1.
+    return {m.name: m.compute(run) for stage in _stages(spec)        # 2-4.
+            for m in TABLE if m.stage == stage}
+
+
+def group_metrics(variants):
+    """The group metrics over summary entries (each with ``metrics``): {}
+    with fewer than two runs that have the final attitude errors."""
+    if _std(variants) is None:
+        return {}
+    return {m.name: m.compute(variants) for m in TABLE if m.scope == "group"}
+
+
+# ---------------------------------------------------------------------------
+# Lookups
+# ---------------------------------------------------------------------------
+def info(name):
+    """The `Metric` of ``name``, or None."""
+    return _BY_NAME.get(name)
+
+
+def dimension(name):
+    """The `pyins.units` dimension of a metric ("dimensionless" if unknown)."""
+    m = _BY_NAME.get(name)
+    return m.dimension if m else "dimensionless"
+
+
+def describe(name):
+    """What a metric means ("" if unknown)."""
+    m = _BY_NAME.get(name)
+    return m.description if m else ""
+
+
+def si_unit(name):
+    """The SI unit a metric is held in ("rad", "m", "m/s", "rad/s"; "" if unknown)."""
+    m = _BY_NAME.get(name)
+    return m.si_unit if m else ""
+
+
+_SI_SUFFIX = {"length": "_m", "angle": "_rad", "velocity": "_mps", "angular_rate": "_rad_s"}
+
+
+def si_name(name):
+    """``level_error_final`` -> ``level_error_final_rad`` (the SI unit in the name)."""
+    return name + _SI_SUFFIX.get(dimension(name), "")
+
+
+def display(name, values_si=()):
+    """(unit, scale) a metric is shown in: value shown = value_si / scale.
+
+    Horizontal errors are shown in nmi when any of ``values_si`` (None
+    ignored) exceeds half a nautical mile, else in m; every other metric in
+    its unit of the table; unknown names plainly, ("", 1.0).
+    """
+    if name.startswith("horizontal_error"):
+        big = max((abs(v) for v in values_si if v is not None), default=0.0)
+        return ("nmi", NMI_TO_M) if big > 0.5 * NMI_TO_M else ("m", 1.0)
+    m = _BY_NAME.get(name)
+    return (m.unit, m.scale) if m else ("", 1.0)

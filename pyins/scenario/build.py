@@ -1,0 +1,290 @@
+"""Building what runs from a resolved scenario: the ship's motion, the
+sensor errors, the turntable, the firmware's configuration, and the initial
+state handed to the firmware (the truth at t = 0, plus the file's initial
+errors), each built once here; `RunSpec` holds them for one run
+(`pyins.runs.run` runs it).
+
+The firmware's own check of a configuration (``pyins_config_check``) runs
+at load time (`_firmware_check`), so a refused value names its key.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from pyins import native, sim
+from pyins.reference import attitude, earth
+from pyins.scenario.schema import (INDEX_SUMS, _COARSE_METHODS, _FINE_CORRECTIONS, _LINEAR_AXES,
+                                   _STEP_MOVES, _TABLE_FAULTS, _VERTICAL_MODES)
+from pyins.sim import turntable
+from pyins.units import DT, TICK_HZ, ScenarioError
+
+# ---------------------------------------------------------------------------
+# 1. The ship's motion
+# ---------------------------------------------------------------------------
+_SHIP_RESOLVED = ("heave", "surge", "sway", "spectrum", "lever_b_m", "lever_p_m")
+
+
+def _is_ship(m):
+    """True when a resolved [motion] has any ship key (a pyins.sim.ShipAtSea)."""
+    return any(k in m for k in _SHIP_RESOLVED)
+
+
+def _build_motion(m):
+    """A pyins.sim motion object from a resolved [motion] dict: the base
+    profile, wrapped in a ShipAtSea when any ship key is given."""
+    base = _build_base_motion(m)
+    if not _is_ship(m):
+        return base
+    linear = None
+    if "spectrum" in m:
+        linear = _spectrum_motion(m["spectrum"])
+    elif any(a in m for a in _LINEAR_AXES):
+        linear = sim.LinearMotion(**{a: [(c["amplitude_m"], c["period_s"], c["phase_rad"])
+                                         for c in m.get(a, [])] for a in _LINEAR_AXES})
+    return sim.ShipAtSea(base, linear, lever_b=m.get("lever_b_m", (0.0, 0.0, 0.0)),
+                         lever_p=m.get("lever_p_m", (0.0, 0.0, 0.0)))
+
+
+def _build_base_motion(m):
+    """The profile of a resolved [motion] dict without its ship keys."""
+    kind = m["kind"]
+    lat, lon, h = m["lat_rad"], m["lon_rad"], m["height_m"]
+    if kind == "static":
+        return sim.Static(lat, lon, h, m["pitch_rad"], m["roll_rad"], m["yaw_rad"])
+    if kind == "swing":
+        return sim.Swing(lat, lon, h, m["pitch_rad"], m["roll_rad"], m["yaw_rad"],
+                         m["amplitude_rad"], m["frequency_hz"], m["phase_rad"])
+    if kind == "sea_state":
+        return sim.sea_state(m["sea_state"], lat, lon, h, m["yaw_rad"], m["pitch_rad"], m["roll_rad"],
+                             m["phase_rad"])
+    if kind == "heading_swing":
+        return sim.HeadingSwing(lat, lon, h, m["pitch_rad"], m["roll_rad"], m["yaw_rad"],
+                                m["rate_amplitude_rad_s"], m["period_s"])
+    if m["segments"] == "default":
+        segments = sim.default_segments(DT)
+    else:
+        segments = [sim.Segment(s["kind"], round(s["duration_s"] * TICK_HZ), s["value"])
+                    for s in m["segments"]]
+    try:
+        return sim.Manoeuvre(lat, lon, h, m["yaw_rad"], segments, dt=DT, speed0=m["speed_mps"],
+                             pitch=m["pitch_rad"], roll=m["roll_rad"])
+    except ValueError as exc:
+        raise ScenarioError(str(exc), "motion.segments") from None
+
+
+def _spectrum_motion(sp):
+    return sim.sea_spectrum_motion(sp["hs_m"], sp["tp_s"], spectrum=sp["kind"],
+                                   gamma=sp["gamma"] if sp["gamma"] is not None else 1.0,
+                                   seed=sp["seed"], n_components=sp["components"])
+
+
+# ---------------------------------------------------------------------------
+# 2. The initial state: the truth at t = 0, and the file's errors on it
+# ---------------------------------------------------------------------------
+def initial_truth(motion):
+    """(lat, lon, height, vel_n, euler) of ``motion`` at t = 0.
+
+    A ShipAtSea: its reference point's state, which the firmware's
+    configuration and records mean when a lever arm is configured; every
+    other profile: its own state. A Manoeuvre in closed form (its ``state``
+    would integrate the whole track first; the two agree bit for bit).
+    """
+    if isinstance(motion, sim.Manoeuvre):
+        speed, _, yaw, _ = motion.kinematics(0.0)
+        speed, yaw = float(speed), float(yaw)
+        return (motion.lat0, motion.lon0, motion.height,
+                np.array([-speed * np.sin(yaw), speed * np.cos(yaw), 0.0]),
+                np.array([motion.pitch, motion.roll, yaw]))
+    state = motion.reference_state if hasattr(motion, "reference_state") else motion.state
+    st = state(np.array([0.0]))
+    return float(st.lat[0]), float(st.lon[0]), float(st.height[0]), st.vel_n[0], st.euler[0]
+
+
+def initial_config(motion, table=None, **overrides):
+    """Firmware configuration holding the true state of ``motion`` at t = 0
+    (`initial_truth`) and the table angle of the profile ``table`` (None: 0).
+
+    A ShipAtSea's lever arms ``lever_b_m``/``lever_p_m`` go with it unless
+    overridden; ``overrides`` replace any field.
+    """
+    lat, lon, h, vel, euler = initial_truth(motion)
+    if hasattr(motion, "reference_state"):
+        overrides = {"lever_b_m": np.asarray(motion.lever_b, dtype=float),
+                     "lever_p_m": np.asarray(motion.lever_p, dtype=float), **overrides}
+    alpha0 = 0.0 if table is None else float(table.state(np.array([0.0]))[0][0])
+    cfg = dict(lat_rad=lat, lon_rad=lon, height_m=h, vel_n_mps=vel, euler_b_rad=euler,
+               table_angle_rad=alpha0)
+    cfg.update(overrides)
+    return cfg
+
+
+def initial_errors(motion, *, phi=None, pitch=None, roll=None, yaw=None, velocity=None, north=None,
+                   east=None, height=None, zero_attitude=False):
+    """The configuration fields of an initial state with errors: the truth of
+    ``motion`` at t = 0 (`initial_truth`) plus the errors given (None: that
+    field is left to the truth and not returned).
+
+    ``phi`` [rad, E N U]: C(firmware) = (I - phi x) C(true), or Euler angle
+    errors ``pitch``/``roll``/``yaw`` [rad]; ``zero_attitude``: all Euler
+    angles zero instead; ``velocity`` [m/s, E N U]; ``north``/``east``/
+    ``height`` [m], the position errors over the radii of curvature at the
+    ellipsoid.
+    """
+    lat, lon, h, vel, euler = initial_truth(motion)
+    cfg = {}
+    if zero_attitude:
+        cfg["euler_b_rad"] = [0.0, 0.0, 0.0]
+    elif phi is not None:
+        cfg["euler_b_rad"] = attitude.mat_to_euler(attitude.rotvec_to_mat(-np.array(phi))
+                                                   @ attitude.euler_to_mat(euler))
+    elif any(v is not None for v in (pitch, roll, yaw)):
+        cfg["euler_b_rad"] = euler + np.array([pitch or 0.0, roll or 0.0, yaw or 0.0])
+    if velocity is not None:
+        cfg["vel_n_mps"] = vel + np.array(velocity)
+    rm, rn = earth.principal_radii(np.sin(lat))
+    if north is not None:
+        cfg["lat_rad"] = lat + north / rm
+    if east is not None:
+        cfg["lon_rad"] = lon + east / (rn * np.cos(lat))
+    if height is not None:
+        cfg["height_m"] = h + height
+    return cfg
+
+
+# ---------------------------------------------------------------------------
+# 3. The firmware configuration, sensor errors and turntable of a variant
+# ---------------------------------------------------------------------------
+def _ticks(seconds):
+    return int(round(seconds * TICK_HZ))
+
+
+def _firmware_config(res, motion):
+    """The overrides for ``fil.run_fil(config=...)``: only what the scenario
+    sets (keys it leaves unset keep the firmware's defaults, and the initial
+    state is the truth, filled in by `initial_config`); ``motion`` is the
+    variant's (`_build_motion`)."""
+    fw, ix, ie = res["firmware"], res["indexing"], res["initial_errors"]
+    cfg = {"index_scheme": ix["scheme_number"]}
+    if fw["vertical_mode"] is not None:
+        cfg["vertical_mode"] = _VERTICAL_MODES[fw["vertical_mode"]]
+    for name, c_name in (("coarse_time_s", "coarse_ticks"),
+                         ("coarse_first_output_s", "coarse_first_output_ticks"),
+                         ("coarse_output_every_s", "coarse_output_every_ticks"),
+                         ("fine_time_s", "fine_ticks"), ("fine_meas_every_s", "fine_meas_every_ticks")):
+        if fw[name] is not None:
+            cfg[c_name] = _ticks(fw[name])
+    for name, c_name in (("coarse_ratio", "coarse_ratio"), ("fine_states", "fine_states"),
+                         ("fine_gyro_arw_rad_sqrt_s", "fine_gyro_arw"),
+                         ("fine_accel_vrw_mps_sqrt_s", "fine_accel_vrw"),
+                         ("fine_sigma0_att_rad", "fine_sigma0_att_rad"),
+                         ("fine_sigma0_gyro_rad_s", "fine_sigma0_gyro"),
+                         ("fine_sigma0_accel_mps2", "fine_sigma0_accel")):
+        if fw[name] is not None:
+            cfg[c_name] = fw[name]
+    if fw["fine_correction"] is not None:
+        cfg["fine_correction"] = _FINE_CORRECTIONS[fw["fine_correction"]]
+    if fw.get("coarse_method") is not None:
+        cfg["coarse_method"] = _COARSE_METHODS[fw["coarse_method"]]
+    if fw.get("lever") == "unknown":
+        # what an unknown lever arm costs: the firmware navigates the reference point as if
+        # the accelerometers were there (initial_config would give it the motion's)
+        cfg["lever_b_m"] = [0.0, 0.0, 0.0]
+        cfg["lever_p_m"] = [0.0, 0.0, 0.0]
+    for name, c_name in (("stop_s", "index_stop_ticks"), ("timeout_s", "index_timeout_ticks")):
+        if ix[name] is not None:
+            cfg[c_name] = _ticks(ix[name])
+    for name, c_name in (("rate_rad_s", "index_rate_rad_s"), ("acceleration_rad_s2", "index_accel_rad_s2"),
+                         ("delta", "index_delta"), ("max_flex_rad", "index_max_flex_rad"),
+                         ("tolerance_rad", "index_tolerance_rad"), ("jump_rad", "index_jump_rad")):
+        if ix[name] is not None:
+            cfg[c_name] = ix[name]
+    if ix["sums"] != "stops":
+        cfg["index_sums"] = INDEX_SUMS[ix["sums"]]
+    if ix["steps"] is not None:
+        cfg["index_n_steps"] = len(ix["steps"])
+        cfg["index_steps"] = [(_ticks(s["stop_s"]), _STEP_MOVES[s["move"]], s["angle_rad"])
+                              for s in ix["steps"]]
+    if res["turntable"]["initial_angle_rad"] != 0.0:
+        cfg["table_angle_rad"] = res["turntable"]["initial_angle_rad"]
+
+    # the initial state: the truth plus the initial errors
+    cfg.update(initial_errors(motion, phi=ie["phi_rad"], pitch=ie["pitch_rad"], roll=ie["roll_rad"],
+                              yaw=ie["yaw_rad"], velocity=ie["velocity_mps"], north=ie["north_m"],
+                              east=ie["east_m"], height=ie["height_m"],
+                              zero_attitude=fw["initial_attitude"] == "zero"))
+    return cfg
+
+
+def _sensor_errors(s):
+    return sim.SensorErrors(
+        gyro_bias=np.array(s["gyro_bias_rad_s"]), gyro_scale=np.array(s["gyro_scale"]),
+        gyro_misalignment=np.array(s["gyro_misalignment_rad"]), gyro_arw=s["gyro_arw_rad_sqrt_s"],
+        gyro_quantum=s["gyro_quantum_rad"], accel_bias=np.array(s["accel_bias_mps2"]),
+        accel_scale=np.array(s["accel_scale"]), accel_misalignment=np.array(s["accel_misalignment_rad"]),
+        accel_vrw=s["accel_vrw_mps_sqrt_s"], accel_quantum=s["accel_quantum_mps"])
+
+
+def _table_config(t):
+    return turntable.TableConfig(rate_max_rad_s=t["rate_max_rad_s"], accel_max_rad_s2=t["accel_max_rad_s2"],
+                                 encoder_lsb_rad=t["encoder_lsb_rad"], jump_rad=t["jump_rad"],
+                                 fault_tick=_ticks(t["fault_time_s"]), fault=_TABLE_FAULTS[t["fault"]])
+
+
+#: pyins_status name -> the scenario key it most likely concerns.
+_STATUS_KEYS = {
+    "PYINS_E_CONFIG_LAT": "motion.lat", "PYINS_E_CONFIG_LON": "motion.lon",
+    "PYINS_E_CONFIG_HEIGHT": "motion.height", "PYINS_E_CONFIG_VEL": "initial_errors.velocity",
+    "PYINS_E_CONFIG_ATT": "motion", "PYINS_E_CONFIG_MODE": "firmware.vertical_mode",
+    "PYINS_E_CONFIG_ALIGN_RATIO": "firmware.coarse_ratio",
+    "PYINS_E_CONFIG_ALIGN_EARLY": "firmware.coarse_first_output",
+    "PYINS_E_CONFIG_ALIGN_LONG": "firmware.coarse_time",
+    "PYINS_E_CONFIG_ALIGN_TICKS": "firmware.coarse_time", "PYINS_E_CONFIG_FINE": "firmware.fine_states",
+    "PYINS_E_CONFIG_NOISE": "firmware", "PYINS_E_CONFIG_INDEX_SCHEME": "indexing.scheme",
+    "PYINS_E_CONFIG_INDEX_EMPTY": "indexing.steps", "PYINS_E_CONFIG_INDEX_RATE": "indexing.rate",
+    "PYINS_E_CONFIG_INDEX_DELTA": "indexing.delta", "PYINS_E_CONFIG_INDEX_STEP": "indexing",
+    "PYINS_E_CONFIG_INDEX_SUMS": "indexing.sums", "PYINS_E_CONFIG_LEVER": "motion.lever_b",
+    "PYINS_E_CONFIG_COARSE_METHOD": "firmware.coarse_method",
+}
+
+
+def _firmware_check(motion, cfg):
+    """The firmware's own check (pyins_config_check) of the configuration a
+    run of ``motion`` with the overrides ``cfg`` hands it."""
+    status = native.lib.pyins_config_check(native.make_config(initial_config(motion, None, **cfg)))
+    if status != 0:
+        name = native.status_str(status).split(":")[0]
+        raise ScenarioError(f"the firmware refuses the configuration: {native.status_str(status)}",
+                            _STATUS_KEYS.get(name, "firmware"))
+
+
+# ---------------------------------------------------------------------------
+# 4. One run
+# ---------------------------------------------------------------------------
+@dataclass
+class RunSpec:
+    """One run of a scenario: everything ``pyins.fil.run_fil`` needs
+    (`pyins.runs.run` runs it)."""
+    label: str                    #: the [compare] label (the scenario name without [compare])
+    index: int                    #: position among the scenario's runs
+    scenario: str                 #: the scenario's name
+    motion: object                #: a pyins.sim motion profile (fresh object per RunSpec)
+    errors: object                #: pyins.sim.SensorErrors
+    config: dict                  #: firmware configuration overrides (fil.run_fil config=)
+    table: object                 #: pyins.sim.turntable.TableConfig
+    duration_ticks: int
+    seed: int
+    every: int                    #: record interval [ticks]
+    dt: float = DT
+    outputs: dict = None          #: the resolved [outputs] (plots, csv, records)
+
+
+def _runspec(res, label, index):
+    """The RunSpec of one resolved variant."""
+    motion = _build_motion(res["motion"])
+    return RunSpec(label=label, index=index, scenario=res["name"], motion=motion,
+                   errors=_sensor_errors(res["sensors"]), config=_firmware_config(res, motion),
+                   table=_table_config(res["turntable"]), duration_ticks=_ticks(res["duration_s"]),
+                   seed=res["seed"], every=_ticks(res["record_every_s"]), dt=DT,
+                   outputs=dict(res["outputs"]))
+
+
