@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from pyins import __version__, bench, campaign, engine, logs, native, report, runner, runs, scenario, sim
+from pyins import __version__, bench, campaign, engine, logs, metrics, native, report, runner, runs, scenario, sim
 from pyins.progress import TextProgress
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DT, NMI_TO_M, TICK_HZ
 
@@ -51,7 +51,7 @@ def _demo(args):
     wall = time.perf_counter() - t0
     if not args.quiet and sys.stdout.isatty():
         print()
-    e = runner.nav_errors(result)
+    e = metrics.nav_errors(result)
     arcsec, arcmin = ARCSEC_TO_RAD, ARCMIN_TO_RAD
     summary = {
         "scenario": "seed 002 experiment 1 heading swing, IMU fixed to the ship",
@@ -205,7 +205,7 @@ def cmd_simulate(args):
     sensors = sim.SensorModel(spec.errors, seed=spec.seed)
     parts = []
     for chunk in sim.generate(spec.motion, spec.duration_ticks, chunk_ticks=200_000, dt=spec.dt,
-                              table=sim.motion.Fixed(alpha0), sensors=sensors, with_truth=False):
+                              table=sim.Fixed(alpha0), sensors=sensors, with_truth=False):
         parts.append((chunk.tick, chunk.dtheta_p, chunk.dv_p, chunk.table_angle))
     tick = np.concatenate([p[0] for p in parts])
     data = sim.io.ImuData(tick=tick.astype(np.int64), dtheta_p=np.concatenate([p[1] for p in parts]),

@@ -180,7 +180,7 @@ def predict_static_fil(result, lat, euler_b, gyro_bias_p, accel_bias_p, times_s,
                        step_s=0.5):
     """What the linear error model says a static FIL run should show.
 
-    ``result`` is a ``pyins.fil.FilResult`` (its plant records give the table
+    ``result`` is a ``pyins.records.FilResult`` (its plant records give the table
     angle); the constant gyro drifts and accelerometer biases of the IMU
     frame are projected through the table angle and propagated by
     ``static_error_model``. Scale-factor, installation and random errors are

@@ -10,7 +10,7 @@ Three figures on this machine, each timed for about ``seconds``:
 """
 import time
 
-from pyins import engine, fil, native, runner, sim
+from pyins import engine, fil, native, scenario, sim
 from pyins.units import DT
 
 
@@ -33,7 +33,7 @@ def run(seconds=3.0):
     dth, dv, al = sim.exact_increments(m, n)
     dth, dv = sim.SensorModel(errors, seed=1).apply(dth, dv)
     samples = native.make_samples(dth, dv, al)
-    cfg = runner.initial_config(m, None)
+    cfg = scenario.initial_config(m, None)
 
     def cpp():
         native.Firmware(cfg).run(samples, every=100)

@@ -29,44 +29,12 @@ import numpy as np
 
 from pyins import engine as engines
 from pyins import native, records, sim
-from pyins.progress import TextProgress
 from pyins.records import CHECKPOINT, PLANT_RECORD_DTYPE, FilResult, load_records
 from pyins.scenario.build import initial_config
 from pyins.sim.turntable import TableConfig, error_matrices
 from pyins.units import DT
 
-__all__ = ["run_fil", "periodic_ticks", "FilResult", "TextProgress", "load_records",
-           "PLANT_RECORD_DTYPE", "CHECKPOINT"]
-
-
-def periodic_ticks(motion, dt, limit=2_000_000):
-    """Ticks after which the ship's body rate and force repeat exactly, or
-    None. Static: 1. Swings: the least common multiple of each active
-    frequency's whole-tick period (at most 1000 cycles). A ShipAtSea: the
-    same over the base swing's and the linear motion's frequencies (1 when
-    nothing moves)."""
-    if isinstance(motion, sim.Static):
-        return 1
-    if isinstance(motion, sim.ShipAtSea):
-        freqs = motion.frequencies_hz
-    elif isinstance(motion, sim.Swing):
-        freqs = [f for amp, f in zip(motion.amplitude, motion.frequency_hz)
-                 if amp != 0.0 and f != 0.0]
-    else:
-        return None
-    period = 1
-    for f in freqs:
-        ticks_per_cycle = 1.0 / (f * dt)
-        for cycles in range(1, 1001):
-            p = cycles * ticks_per_cycle
-            if abs(p - round(p)) < 1e-9 * p:
-                break
-        else:
-            return None
-        period = math.lcm(period, int(round(p)))
-        if period > limit:
-            return None
-    return period
+__all__ = ["run_fil"]
 
 
 class _Loop:
@@ -80,7 +48,7 @@ class _Loop:
         self.rng = np.random.default_rng(seed)
         self.noisy = errors.gyro_arw > 0.0 or errors.accel_vrw > 0.0
         self.sq = math.sqrt(dt)
-        self.period = periodic_ticks(motion, dt)
+        self.period = sim.periodic_ticks(motion, dt)
         if self.period is not None:          # one period of the ship's rates serves every chunk
             self.omega, self.force, self.x, self.w = sim.node_rates(motion, np.arange(self.period), dt=dt,
                                                                     nodes=nodes)
@@ -116,7 +84,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     ``TableConfig``; ``engine``: "native" (the compiled firmware and plant)
     or "reference" (their NumPy mirrors, `pyins.engine`).
     ``progress(done_ticks, total_ticks)`` is called after every chunk
-    (``TextProgress()`` draws a bar). With ``record_dir`` the decimated
+    (``pyins.progress.TextProgress()`` draws a bar). With ``record_dir`` the decimated
     records are streamed to ``outputs.bin`` and ``plant.bin`` there (raw
     OUTPUT_DTYPE / PLANT_RECORD_DTYPE, described in ``records.json``) chunk
     by chunk and returned memory-mapped, so memory stays bounded for any

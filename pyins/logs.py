@@ -113,8 +113,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyins.reference.earth import DEG_TO_RAD, DPH_TO_RPS, G0
-from pyins.reference.firmware import DEFAULT_TICK_HZ
+from pyins.units import DEG_TO_RAD, DPH_TO_RPS, DT, G0
 from pyins.sim import io
 from pyins.sim.io import ImuData
 
@@ -144,7 +143,7 @@ GAP_TICKS = 1.5          #: a step longer than this many dt is a gap
 MIN_STEP_TICKS = 0.5     #: a step shorter than this many dt is an error
 GYRO_RATE_LIMIT = 10.0   #: [rad/s] above this the gyro unit is wrong
 GRAVITY_BAND = (0.5 * G0, 2.0 * G0)  #: [m/s^2] plausible median |specific force|
-DEFAULT_DT = 1.0 / DEFAULT_TICK_HZ   #: [s] for plausibility checks of a CSV without dt
+DEFAULT_DT = DT                     #: [s] for plausibility checks of a CSV without dt
 MAX_LISTED = 10          #: gaps listed one by one before a summary
 
 

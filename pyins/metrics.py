@@ -62,7 +62,7 @@ class NavErrors:
 def nav_errors(result):
     """Position, velocity and attitude errors of a result with ``outputs``
     (firmware records), ``truth`` (pyins.sim.Truth at the same ticks) and
-    ``dt`` (a runner.RunResult or a fil.FilResult)."""
+    ``dt`` (a runner.RunResult or a records.FilResult)."""
     out, tr = result.outputs, result.truth
     lat_t = tr.lat
     rm, rn = earth.principal_radii(np.sin(lat_t))
@@ -235,7 +235,7 @@ def _stages(spec):
 
 def run_metrics(spec, res):
     """The run metrics of one run (SI units): ``res`` holds its records
-    and truth (a fil.FilResult); {} when it has no records."""
+    and truth (a records.FilResult); {} when it has no records."""
     if len(res.outputs) == 0:
         return {}
     run = _Run(spec, res)                                            # 1.

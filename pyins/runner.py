@@ -6,10 +6,9 @@ engine (`pyins.engine`: the C++ core or its NumPy mirror) keeping one record
 every ``every`` ticks, and returns those records beside the true state at
 the same ticks. The closed loop with the turntable is `pyins.fil`.
 
-``initial_config`` (the truth at t = 0 as a firmware configuration) is
-`pyins.scenario.build.initial_config`, and ``nav_errors`` (the errors in
-physical units) `pyins.metrics.nav_errors`; both are importable from here,
-where the open-loop callers look for them.
+The firmware starts from `pyins.scenario.initial_config` (the truth at
+t = 0 as a firmware configuration); the errors in physical units are
+`pyins.metrics.nav_errors`.
 """
 from dataclasses import dataclass
 
@@ -17,11 +16,10 @@ import numpy as np
 
 from pyins import engine as engines
 from pyins import native, sim
-from pyins.metrics import NavErrors, nav_errors
 from pyins.scenario.build import initial_config
 from pyins.units import DT
 
-__all__ = ["RunResult", "NavErrors", "initial_config", "navigate", "nav_errors"]
+__all__ = ["RunResult", "navigate"]
 
 
 @dataclass

@@ -53,7 +53,7 @@ def slug(label):
 def run(spec, engine="native", **kwargs):
     """One run of a scenario (a pyins.scenario.RunSpec) through the firmware
     in the loop; ``kwargs`` go to ``fil.run_fil`` (record_dir, resume,
-    progress, ...). Returns a fil.FilResult."""
+    progress, ...). Returns a records.FilResult."""
     return fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=spec.errors,
                        seed=spec.seed, table=spec.table, every=spec.every, dt=spec.dt, engine=engine,
                        **kwargs)
@@ -165,7 +165,7 @@ def replay_config(spec):
     """The firmware configuration replaying a log of ``spec`` (a RunSpec)
     starts from: its initial state and settings, without indexing (a log's
     table angles are recorded: the firmware commands nothing)."""
-    cfg = runner.initial_config(spec.motion, None, **spec.config)
+    cfg = scenario.initial_config(spec.motion, None, **spec.config)
     cfg["index_scheme"] = 0
     return cfg
 

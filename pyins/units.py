@@ -42,6 +42,8 @@ DEG_TO_RAD = np.pi / 180.0                 #: (kDegToRad)
 ARCSEC_TO_RAD = DEG_TO_RAD / 3600.0        #: (kArcsecToRad)
 ARCMIN_TO_RAD = DEG_TO_RAD / 60.0          #: (kArcminToRad)
 DPH_TO_RPS = DEG_TO_RAD / 3600.0           #: deg/h -> rad/s (kDphToRps)
+#: deg/sqrt(h) -> rad/sqrt(s): DEG / sqrt(3600 s) (an angle random walk)
+DPSH_TO_RPSS = DEG_TO_RAD / 60.0
 G0 = 9.80665                               #: standard gravity for ug/mg units [m/s^2] (kG0)
 UG_TO_MPS2 = 1e-6 * G0                     #: micro-g -> m/s^2 (kUgToMps2)
 NMI_TO_M = 1852.0                          #: nautical mile [m] (kNmiToM)
@@ -90,7 +92,7 @@ UNITS = {
     "angular_acceleration": {"rad/s^2": 1.0, "deg/s^2": _DEG},
     # 1 deg/sqrt(h) = DEG / sqrt(3600 s) = DEG / 60 rad/sqrt(s) (as pyins.sim.sensors);
     # a rate density [rad/s/sqrt(Hz)] is numerically the same as rad/sqrt(s).
-    "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": _DEG / 60.0,
+    "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": DPSH_TO_RPSS,
                           "rad/s/sqrt(Hz)": 1.0, "deg/h/sqrt(Hz)": DPH_TO_RPS},
     "acceleration": {"m/s^2": 1.0, "g": _G0, "mg": 1e-3 * _G0, "ug": UG_TO_MPS2},
     # 1 ug/sqrt(Hz) = UG_TO_MPS2 (m/s^2)/sqrt(Hz), numerically the same in (m/s)/sqrt(s).

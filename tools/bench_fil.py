@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from pyins import fil, native, runner, sim
+from pyins import fil, metrics, native, scenario, sim
 from pyins.reference import firmware as ref_firmware
 from pyins.sim import turntable
 from pyins.units import DT, TICK_HZ
@@ -45,13 +45,13 @@ def main(argv=None):
     dth, dv, al = sim.exact_increments(m, n)
     dth, dv = sim.SensorModel(errors, seed=1).apply(dth, dv)
     samples = native.make_samples(dth, dv, al)
-    fw = native.Firmware(runner.initial_config(m, None, **cfg))
+    fw = native.Firmware(scenario.initial_config(m, None, **cfg))
     t0 = time.perf_counter()
     fw.run(samples)
     t_fw = time.perf_counter() - t0
     # the NumPy loop
     k = int(args.ref_seconds * TICK_HZ)
-    ref = ref_firmware.Firmware(runner.initial_config(m, None, **cfg))
+    ref = ref_firmware.Firmware(scenario.initial_config(m, None, **cfg))
     st, tab, mats = turntable.PlantState(), turntable.TableConfig(), turntable.error_matrices(errors)
     omega, force, x, w = sim.node_rates(m, np.arange(k))
     z = np.random.default_rng(1).standard_normal((k, 6)) * np.sqrt(DT)
@@ -92,7 +92,7 @@ def main(argv=None):
     res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=1, every=100)
     wall = time.perf_counter() - t0
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     fig.update({"long_run_hours": args.hours, "long_run_ticks": ticks, "long_run_wall_s": wall,
                 "long_run_ticks_per_s": ticks / wall, "peak_memory_mib": peak_mib,
                 "long_run_max_horizontal_error_m": float(e.horizontal_m.max())})

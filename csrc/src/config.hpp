@@ -36,7 +36,7 @@ inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminToRad, 100.0 *
                                                    600.0 * kArcminToRad};  ///< 10 x [10', 10', 60']
 /// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
 /// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
-/// tools/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
+/// tools/papers/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
 /// heading let the wave noise swing the early heading by 80' (measured).
 inline constexpr double kDefaultMovingSigmaAtt[3] = {1.0 * kArcminToRad, 1.0 * kArcminToRad,
                                                      10.0 * kArcminToRad};

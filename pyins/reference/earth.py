@@ -30,9 +30,8 @@ GAMMA_E = 9.7803253359             #: normal gravity at the equator [m/s^2] (kGa
 K_SOMIGLIANA = 0.00193185265241    #: Somigliana constant k [-] (kSomigliana)
 M_GRAV = OMEGA_IE * OMEGA_IE * A * A * B / GM  #: m = w^2 a^2 b / GM [-] (kMGrav)
 
-# --- named unit conversions: defined once, in pyins.units (units.hpp) -----
-from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS, G0,  # noqa: E402,F401
-                         NMI_TO_M, UG_TO_MPS2)
+# The unit conversions (degrees, arcmin, deg/h, ug, ...) are pyins.units
+# (units.hpp), not part of the Earth model.
 
 
 def principal_radii(sin_lat):

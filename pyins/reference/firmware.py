@@ -20,7 +20,6 @@ from pyins.units import ARCMIN_TO_RAD
 from . import abi, attitude, coarse_align, config, earth, fine_align, indexing, moving_align, strapdown
 from .angle import wrap_pi, wrap_two_pi
 from .attitude import cross
-from .config import DEFAULT_TICK_HZ  # noqa: F401  (read here by pyins/logs.py)
 from .config import finite3
 
 SEQ_NEXT, SEQ_GAP, SEQ_REPEAT, SEQ_LOST = 0, 1, 2, 3   #: SeqKind

@@ -32,7 +32,7 @@ from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, eule
 from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
                           save_npz)
 from pyins.sim.motion import (SEA_STATES, HeadingSwing, Manoeuvre, Motion, MotionState, Segment,
-                              Static, Swing, default_segments, sea_state)
+                              Static, Swing, default_segments, periodic_ticks, sea_state)
 from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
 from pyins.sim.ship import (MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, dnv_gamma,
                             heave_response, jonswap, moored, named_sea_spectrum,

@@ -43,12 +43,13 @@ References
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 from numpy.polynomial.legendre import leggauss
 
 from pyins.reference import earth
 from pyins.sim.exact_time import as_times, frac_cycles
-from pyins.sim.turntable import ConstantRate, Fixed  # re-exported for callers outside pyins.sim
 from pyins.units import DEG_TO_RAD, DT, TWO_PI
 
 
@@ -74,11 +75,40 @@ class Motion:
     """Base class of the ship profiles: ``state(t, t_lo=None) -> MotionState``.
 
     ``duration`` is the length of the profile [s] (``inf`` when unbounded).
+    ``frequencies_hz`` are the active frequencies of a profile whose rates
+    repeat (``()`` when nothing moves), None when they need not repeat
+    (`periodic_ticks`).
     """
     duration = np.inf
+    frequencies_hz = None
 
     def state(self, t, t_lo=None):
         raise NotImplementedError
+
+
+def periodic_ticks(motion, dt, limit=2_000_000):
+    """Ticks after which the ship's body rate and force repeat exactly, or
+    None: the least common multiple of each active frequency's whole-tick
+    period (at most 1000 cycles, at most ``limit`` ticks); 1 when nothing
+    moves; None for a profile that need not repeat (``frequencies_hz`` None).
+    The closed loop (`pyins.fil`) computes such a profile's rates once per
+    period."""
+    freqs = motion.frequencies_hz
+    if freqs is None:
+        return None
+    period = 1
+    for f in freqs:
+        ticks_per_cycle = 1.0 / (f * dt)
+        for cycles in range(1, 1001):
+            p = cycles * ticks_per_cycle
+            if abs(p - round(p)) < 1e-9 * p:
+                break
+        else:
+            return None
+        period = math.lcm(period, int(round(p)))
+        if period > limit:
+            return None
+    return period
 
 
 # ---------------------------------------------------------------------------
@@ -100,6 +130,8 @@ class Static(Motion):
     pitch, roll, yaw : float
         Euler angles [rad]; yaw counter-clockwise from North.
     """
+
+    frequencies_hz = ()
 
     def __init__(self, lat, lon, height, pitch=0.0, roll=0.0, yaw=0.0):
         self.lat, self.lon, self.height = float(lat), float(lon), float(height)
@@ -146,6 +178,12 @@ class Swing(Motion):
         self.amplitude = np.asarray(amplitude, dtype=float).reshape(3)
         self.frequency_hz = np.asarray(frequency_hz, dtype=float).reshape(3)
         self.phase = np.asarray(phase, dtype=float).reshape(3)
+
+    @property
+    def frequencies_hz(self):
+        """The active frequencies [Hz]: those with a non-zero amplitude."""
+        return tuple(float(f) for amp, f in zip(self.amplitude, self.frequency_hz)
+                     if amp != 0.0 and f != 0.0)
 
     @classmethod
     def sea_state(cls, name, lat, lon, height, yaw0, pitch0=0.0, roll0=0.0,

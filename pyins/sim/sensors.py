@@ -32,10 +32,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pyins.units import ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS, DT, UG_TO_MPS2
+from pyins.units import ARCSEC_TO_RAD, DPH_TO_RPS, DPSH_TO_RPSS, DT, UG_TO_MPS2
 
 #: deg/sqrt(h) -> rad/sqrt(s)
-DPSH_TO_RPSS = DEG_TO_RAD / 60.0
 #: ug/sqrt(Hz) -> (m/s)/sqrt(s)
 UGPSHZ_TO_MPSPSS = UG_TO_MPS2
 #: ppm -> dimensionless

@@ -297,7 +297,7 @@ class ShipAtSea(Motion):
     @property
     def frequencies_hz(self):
         """Active frequencies [Hz] of the base swing and of the linear motion
-        (what `pyins.fil.periodic_ticks` needs; empty when nothing moves)."""
+        (what `pyins.sim.motion.periodic_ticks` needs; empty when nothing moves)."""
         out = []
         if isinstance(self.base, Swing):
             out += [float(f) for a, f in zip(self.base.amplitude, self.base.frequency_hz)
@@ -469,7 +469,7 @@ def sea_spectrum_motion(hs, tp, spectrum="jonswap", gamma=3.3, seed=0, n_compone
     surge and sway ``surge_ratio`` and ``sway_ratio`` times the heave
     response (a moored ship, held by its lines: 0.5 and 0.4 by default).
     The LCM of the rounded periods is far beyond a run, so
-    `pyins.fil.periodic_ticks` treats the result as not periodic.
+    `pyins.sim.motion.periodic_ticks` treats the result as not periodic.
 
     Parameters
     ----------

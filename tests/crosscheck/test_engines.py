@@ -18,10 +18,11 @@ import pytest
 from pyins import native
 from pyins import reference
 from pyins.reference import abi, earth
+from pyins import units
 
 ENGINES = {"native": native.Firmware, "reference": reference.Firmware}
 N = 2600
-LAT = 30.0 * earth.DEG_TO_RAD
+LAT = 30.0 * units.DEG_TO_RAD
 CFG = dict(lat_rad=LAT, euler_b_rad=[0.0, 0.0, 0.4], coarse_ticks=1000, coarse_first_output_ticks=500,
            coarse_output_every_ticks=100, fine_ticks=1000, index_scheme=abi.PYINS_INDEX_TWO_POSITION,
            seq_mode=abi.PYINS_SEQ_CHECK)

@@ -6,11 +6,12 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
-from pyins.reference import attitude, earth
+from pyins import native, scenario, sim
+from pyins.reference import attitude
 from pyins.reference import firmware as ref_firmware
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 @st.composite
@@ -33,7 +34,7 @@ def test_coarse_alignment_cpp_equals_reference(sc):
     m, align_cfg = sc
     n = align_cfg["coarse_ticks"] + 50          # and a little navigation after it
     dtheta, dv, alpha = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, **align_cfg)
+    cfg = scenario.initial_config(m, None, **align_cfg)
     out_c = native.Firmware(cfg).run(native.make_samples(dtheta, dv, alpha))
     ref = ref_firmware.Firmware(cfg)
     for k in range(n):

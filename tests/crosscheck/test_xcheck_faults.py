@@ -14,11 +14,12 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 from pyins.reference import attitude, earth
 from pyins.reference import firmware as ref_firmware
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 N = 1200
 FAULTS = ("drop", "dup", "stale", "nan", "sat_gyro", "sat_accel", "sat_edge", "jump", "lost", "restart")
 COUNTERS = ref_firmware.COUNTERS
@@ -102,7 +103,7 @@ def deliveries(dtheta, dv, alpha, events, seq0, cfg_resolved):
 def test_fault_sequences_cpp_equals_reference(run):
     m, table, cfg_over, events, seq0 = run
     dtheta, dv, alpha = sim.exact_increments(m, N, table=table)
-    cfg = runner.initial_config(m, table, **cfg_over)
+    cfg = scenario.initial_config(m, table, **cfg_over)
     fw = native.Firmware(cfg)
     ref = ref_firmware.Firmware(cfg)
     statuses = set()
@@ -135,7 +136,7 @@ def test_every_fault_kind_meets_its_status():
     """One run with each fault kind once, in navigation: every status shows."""
     m = sim.sea_state("general", 0.6, 0.3, 0.0, yaw0=1.0)
     dtheta, dv, alpha = sim.exact_increments(m, N)
-    cfg = runner.initial_config(m, None, seq_mode=1)
+    cfg = scenario.initial_config(m, None, seq_mode=1)
     ref = ref_firmware.Firmware(cfg)
     events = {100 * (i + 1): (kind, 1) for i, kind in enumerate(FAULTS)}
     statuses = [ref.step(d, v, a, seq)[0] for d, v, a, seq in deliveries(dtheta, dv, alpha, events, 1, ref.cfg)]

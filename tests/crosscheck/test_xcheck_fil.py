@@ -7,12 +7,13 @@ BLAS vs Eigen order), far below the bounds: attitude 1e-10 rad, table angle
 import numpy as np
 import pytest
 
-from pyins import fil, native, runner, sim
-from pyins.reference import attitude, earth
+from pyins import fil, native, scenario, sim
+from pyins.reference import attitude
 from pyins.reference import firmware as ref_firmware
 from pyins.sim import turntable
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 @pytest.mark.parametrize("scheme, sums", [(2, 0), (4, 0), (6, 1)])
@@ -27,7 +28,7 @@ def test_fil_cpp_equals_numpy(scheme, sums):
     res = fil.run_fil(m, n, config=cfg, errors=errors, seed=3, every=1)
 
     # the NumPy loop with the same noise draw
-    fw = ref_firmware.Firmware(runner.initial_config(m, None, **cfg))
+    fw = ref_firmware.Firmware(scenario.initial_config(m, None, **cfg))
     st = turntable.PlantState()
     tab = turntable.TableConfig()
     mats = turntable.error_matrices(errors)
@@ -56,10 +57,10 @@ def test_fil_cpp_equals_numpy(scheme, sums):
 def test_periodic_ship_motion_is_tiled_exactly():
     """Tiling one period of the ship's node rates equals computing them."""
     m = sim.sea_state("bad", 0.6, 0.0, 0.0, yaw0=1.0)
-    p = fil.periodic_ticks(m, 0.01)
+    p = sim.periodic_ticks(m, units.DT)
     assert p == 1000                       # 0.2 and 0.3 Hz: 5 s and 3.33 s -> 10 s
     o1, f1, _, _ = sim.node_rates(m, np.arange(3) + 7)
     o2, f2, _, _ = sim.node_rates(m, np.arange(3) + 7 + 5 * p)
     np.testing.assert_allclose(o2, o1, rtol=0, atol=1e-15)
     np.testing.assert_allclose(f2, f1, rtol=0, atol=1e-13)
-    assert fil.periodic_ticks(sim.Manoeuvre.default(0.6, 0.0, 0.0, 0.0), 0.01) is None
+    assert sim.periodic_ticks(sim.Manoeuvre.default(0.6, 0.0, 0.0, 0.0), units.DT) is None

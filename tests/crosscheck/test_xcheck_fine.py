@@ -6,12 +6,13 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 from pyins.reference import attitude, earth
 from pyins.reference import firmware as ref_firmware
 from pyins.units import DT
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 @st.composite
@@ -41,7 +42,7 @@ def test_alignment_cpp_equals_reference(sc):
     n = align_cfg["coarse_ticks"] + align_cfg["fine_ticks"] + 20
     dtheta, dv, alpha = sim.exact_increments(m, n)
     dtheta, dv = sim.SensorModel(sim.preset("seed001"), seed=seed).apply(dtheta, dv)
-    cfg = runner.initial_config(m, None)
+    cfg = scenario.initial_config(m, None)
     cfg.update(align_cfg)
     out_c = native.Firmware(cfg).run(native.make_samples(dtheta, dv, alpha))
     ref = ref_firmware.Firmware(cfg)

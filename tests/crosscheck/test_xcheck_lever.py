@@ -12,11 +12,12 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
-from pyins.reference import attitude, earth
+from pyins import native, scenario, sim
+from pyins.reference import attitude
 from pyins.reference import firmware as ref_firmware
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 R_EARTH = 6.4e6   # [m] per rad of latitude, for the position bound
 
 
@@ -69,7 +70,7 @@ def test_lever_arm_and_moving_base_cpp_equals_reference(sc):
     m, table, align_cfg, kind = sc
     n = align_cfg.get("coarse_ticks", 0) + align_cfg.get("fine_ticks", 0) + 300
     dtheta, dv, alpha = sim.exact_increments(m, n, table=table)
-    cfg = runner.initial_config(m, None, **align_cfg)
+    cfg = scenario.initial_config(m, None, **align_cfg)
     if table is not None:
         cfg["table_angle_rad"] = 0.3
     out_c = native.Firmware(cfg).run(native.make_samples(dtheta, dv, alpha))
@@ -97,7 +98,7 @@ def test_ten_minutes_of_moving_base_alignment_cpp_equals_reference():
     # 1.2) m; FIT coarse alignment for 120 s, then 480 s of the moving-base
     # fine alignment (12 states), then 60 s of navigation.
     m = sim.moored("general", 34.246 * DEG, 108.91 * DEG, 380.0, 0.7)
-    cfg = runner.initial_config(m, None, coarse_ticks=12000, coarse_method=1, fine_ticks=48000,
+    cfg = scenario.initial_config(m, None, coarse_ticks=12000, coarse_method=1, fine_ticks=48000,
                                 fine_states=12)
     out = _run_both(m, cfg, 66000)
     assert out[-1]["mode"] == 3 and out[-1]["kf_states"] == 12
@@ -106,7 +107,7 @@ def test_ten_minutes_of_moving_base_alignment_cpp_equals_reference():
 def test_fit_beyond_its_grid_cpp_equals_reference():
     # FIT halves its grid when full: 400 s on 1 s outputs crosses 255 intervals
     m = sim.moored("bad", 34.246 * DEG, 108.91 * DEG, 380.0, 2.0)
-    cfg = runner.initial_config(m, None, coarse_ticks=40000, coarse_method=1)
+    cfg = scenario.initial_config(m, None, coarse_ticks=40000, coarse_method=1)
     _run_both(m, cfg, 40100)
 
 
@@ -116,6 +117,6 @@ def test_fine_alignment_with_lever_arm_cpp_equals_reference():
     base = sim.sea_state("general", 34.246 * DEG, 108.91 * DEG, 380.0, 0.7)
     m = sim.ShipAtSea(base, None, lever_b=(0.5, 1.5, 1.2))
     for states in (5, 8):
-        cfg = runner.initial_config(m, None, coarse_ticks=6000, coarse_method=1, fine_ticks=12000,
+        cfg = scenario.initial_config(m, None, coarse_ticks=6000, coarse_method=1, fine_ticks=12000,
                                     fine_states=states)
         _run_both(m, cfg, 18100)

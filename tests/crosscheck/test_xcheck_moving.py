@@ -11,9 +11,10 @@ from hypothesis import strategies as st
 import hooks
 from pyins.reference import attitude, coarse_align, earth, moving_align  # noqa: I001
 from pyins.units import DT
+from pyins import units
 
 ffi, lib = hooks.ffi, hooks.lib
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 @settings(max_examples=50, deadline=None)

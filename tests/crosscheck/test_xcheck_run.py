@@ -11,11 +11,12 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 from pyins.reference import attitude, earth
 from pyins.reference import firmware as ref_firmware
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 @st.composite
@@ -38,7 +39,7 @@ def test_ten_minutes_cpp_equals_reference(profile):
     motion, table = profile
     n = 60_000
     dtheta, dv, alpha = sim.exact_increments(motion, n, table=table)
-    cfg = runner.initial_config(motion, table)
+    cfg = scenario.initial_config(motion, table)
     out_c = native.Firmware(cfg).run(native.make_samples(dtheta, dv, alpha), every=1000)
     ref = ref_firmware.Firmware(cfg)
     keep = []

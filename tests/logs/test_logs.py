@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from pyins import logs
-from pyins.reference.earth import DEG_TO_RAD
-from pyins.sim import imu, io, motion, sensors
+from pyins.units import DEG_TO_RAD
+from pyins.sim import imu, io, motion, sensors, turntable
 from pyins.sim.io import ImuData
 from strategies import finite
 
@@ -42,7 +42,7 @@ def static_log(n=2000, seed=5, table=False):
     """A static IMU at 34 deg latitude with the seed 002 sensor errors and noise."""
     mo = motion.Static(LAT, 108.9 * DEG_TO_RAD, 380.0, pitch=0.01, roll=-0.02, yaw=0.7)
     th, dv, angle = imu.exact_increments(
-        mo, n, table=motion.ConstantRate(0.05) if table else None)
+        mo, n, table=turntable.ConstantRate(0.05) if table else None)
     th, dv = sensors.SensorModel(sensors.preset("seed002"), seed=seed).apply(th, dv)
     return ImuData(np.arange(1, n + 1, dtype=np.int64), th, dv, angle, 0.01, {"seed": seed})
 

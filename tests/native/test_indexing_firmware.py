@@ -3,11 +3,11 @@ in a closed loop with an ideal table, and the encoder faults."""
 import numpy as np
 import pytest
 
-from pyins import native, runner, sim
-from pyins.reference import earth
+from pyins import native, scenario, sim
 from pyins.reference import firmware as ref_firmware
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 def closed_loop(fw_step, n, dtheta, dv, follow):
@@ -26,7 +26,7 @@ def test_cpp_equals_reference_in_closed_loop(scheme, sums):
     m = sim.HeadingSwing.experiment(1)
     n = 4000
     dtheta, dv, _ = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, index_scheme=scheme, index_stop_ticks=400, index_sums=sums)
+    cfg = scenario.initial_config(m, None, index_scheme=scheme, index_stop_ticks=400, index_sums=sums)
     fw = native.Firmware(cfg)
     ref = ref_firmware.Firmware(cfg)
 
@@ -55,7 +55,7 @@ def test_cpp_equals_reference_in_closed_loop(scheme, sums):
 def _faulting(follow, n=3000):
     m = sim.Static(0.6, 0.0, 0.0)
     dtheta, dv, _ = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, index_scheme=2, index_stop_ticks=300)
+    cfg = scenario.initial_config(m, None, index_scheme=2, index_stop_ticks=300)
     fw = native.Firmware(cfg)
     recs = closed_loop(lambda a, b, e: fw.step(a, b, e), n, dtheta, dv, follow)
     return fw, np.array(recs, dtype=native.OUTPUT_DTYPE)

@@ -5,12 +5,13 @@ behaviour holds."""
 import numpy as np
 import pytest
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 from pyins.reference import attitude, earth
 from pyins.units import ARCSEC_TO_RAD, G0, TICK_HZ
+from pyins import units
 
 lib = native.lib
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 ARCSEC = ARCSEC_TO_RAD
 BOOKKEEPING = ("fault_flags", "n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_repeats",
                "n_seq_lost", "n_encoder_jumps", "seq")
@@ -74,7 +75,7 @@ def test_bridging_on_a_bad_sea_interpolates_far_better_than_repeating():
     m = sim.sea_state("bad", 34.246 * DEG, 108.91 * DEG, 0.0, yaw0=0.3)
     n = 1500
     dth, dv, al = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, seq_mode=1)
+    cfg = scenario.initial_config(m, None, seq_mode=1)
     seq = np.arange(1, n + 1)
     full = native.Firmware(cfg).run(native.make_samples(dth, dv, al, seq))
     for gap, bound in ((1, 0.3 * ARCSEC), (2, 1.0 * ARCSEC)):
@@ -164,7 +165,7 @@ def test_duplicates_leave_the_state_bit_identical():
     m = sim.sea_state("general", 0.6, 0.1, 0.0, yaw0=0.5)
     n = 2500
     dth, dv, al = sim.exact_increments(m, n, table=sim.ConstantRate(6 * DEG))
-    cfg = runner.initial_config(m, None, seq_mode=1, fine_ticks=800)
+    cfg = scenario.initial_config(m, None, seq_mode=1, fine_ticks=800)
     s = native.make_samples(dth, dv, al, np.arange(1, n + 1))
     clean = native.Firmware(cfg).run(s)
     dup_at = [0, 5, 799, 800, 1500, 2400]

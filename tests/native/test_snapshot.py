@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 
 M = sim.sea_state("general", 0.6, 0.1, 0.0, yaw0=0.5)
 N = 9000
@@ -13,7 +13,7 @@ _DTH, _DV, _AL = sim.exact_increments(M, N)
 _DTH, _DV = sim.SensorModel(sim.preset("seed001"), seed=4).apply(_DTH, _DV)
 SAMPLES = native.make_samples(_DTH, _DV, _AL)
 # coarse 0-2999, fine 3000-5999, navigation with indexing after
-CFG = runner.initial_config(M, None, coarse_ticks=3000, fine_ticks=3000, index_scheme=4, index_stop_ticks=500,
+CFG = scenario.initial_config(M, None, coarse_ticks=3000, fine_ticks=3000, index_scheme=4, index_stop_ticks=500,
                             euler_b_rad=[0.0, 0.0, 0.0])
 FULL = native.Firmware(CFG).run(SAMPLES)
 

@@ -7,12 +7,13 @@ must sit near the theoretical limit (the part no alignment can observe).
 import numpy as np
 import pytest
 
-from pyins import runner, sim
+from pyins import metrics, runner, scenario, sim
 from pyins.reference import attitude, earth
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
+DEG = units.DEG_TO_RAD
+ARCSEC = units.ARCSEC_TO_RAD
+ARCMIN = units.ARCMIN_TO_RAD
 LAT, LON = 34.246 * DEG, 108.910 * DEG
 HEADINGS = (0, 60, 120, 180, 240, 300)      # marine heading [deg], seed 000's layout
 
@@ -29,7 +30,7 @@ def align(m, seconds, sensors=None, ratio=0.5):
     # the configured attitude is a deliberately wrong guess: alignment must find it
     res = runner.navigate(m, n, every=100, sensors=sensors,
                           config=dict(coarse_ticks=n, coarse_ratio=ratio, euler_b_rad=[0.0, 0.0, 0.0]))
-    return res, runner.nav_errors(res)
+    return res, metrics.nav_errors(res)
 
 
 def theoretical_limit(m, errors, t):
@@ -101,7 +102,7 @@ def test_rejected_sample_during_alignment_restarts_it(bad_tick):
     coarse, fine = 20000, 6000
     n = 2 * (coarse + fine) + 100
     dtheta, dv, alpha = sim.exact_increments(m, n)
-    cfg = runner.initial_config(m, None, coarse_ticks=coarse, fine_ticks=fine, euler_b_rad=[0.0, 0.0, 0.0])
+    cfg = scenario.initial_config(m, None, coarse_ticks=coarse, fine_ticks=fine, euler_b_rad=[0.0, 0.0, 0.0])
     fw = native.Firmware(cfg)
     s = native.make_samples(dtheta, dv, alpha)
     first = fw.run(s[:bad_tick])

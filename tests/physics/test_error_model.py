@@ -9,10 +9,10 @@ say nothing)."""
 import numpy as np
 import pytest
 
-from pyins import analysis, fil, runner, sim
-from pyins.reference import earth
+from pyins import analysis, fil, metrics, sim
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 LAT = 34.0 * DEG
 YAW = -30.0 * DEG
 HOURS = np.array([6.0, 12.0, 24.0])
@@ -21,9 +21,9 @@ HOURS = np.array([6.0, 12.0, 24.0])
 @pytest.mark.parametrize("scheme", [0, 1])
 def test_static_run_matches_linear_error_model(scheme):
     m = sim.Static(LAT, 0.0, 0.0, 0.0, 0.0, YAW)
-    errors = sim.SensorErrors(gyro_bias=np.full(3, 0.01 * earth.DPH_TO_RPS))
+    errors = sim.SensorErrors(gyro_bias=np.full(3, 0.01 * units.DPH_TO_RPS))
     res = fil.run_fil(m, 24 * 360_000, config=dict(index_scheme=scheme), errors=errors, every=100)
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     eps_n = analysis.table_projected(errors.gyro_bias, [0.0, 0.0, YAW], res.plant["tick"] * 0.01,
                                      res.plant["alpha_rad"])
     grid = np.arange(1, 25) * 3600.0

@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from pyins import fil, progress, runner, sim
-from pyins.reference import earth
+from pyins import fil, metrics, progress, sim
 from pyins.sim import turntable
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 
 
 def test_error_free_24h_flexible_scheme_on_heading_swing():
@@ -15,15 +15,15 @@ def test_error_free_24h_flexible_scheme_on_heading_swing():
     the machine really indexes: moves happen, no fault, no fallback."""
     m = sim.HeadingSwing.experiment(1)
     res = fil.run_fil(m, 24 * 360_000, config=dict(index_scheme=4), every=100)
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     o = res.outputs
     print(f"\nerror-free 24 h FIL flexible: max horizontal {e.horizontal_m.max():.3e} m, "
-          f"max attitude {np.abs(e.att_n_rad).max() / earth.ARCSEC_TO_RAD:.2e} arcsec, "
+          f"max attitude {np.abs(e.att_n_rad).max() / units.ARCSEC_TO_RAD:.2e} arcsec, "
           f"max velocity {np.abs(e.vel_n_mps).max():.2e} m/s, table travelled {np.abs(np.diff(res.plant['alpha_rad'])).sum() / DEG:.0f} deg")
     assert e.horizontal_m.max() < 10.0
     # the table really turns the IMU: a frame or sign error in the plant or
     # the firmware would show here at once (degrees, m/s)
-    assert np.abs(e.att_n_rad).max() < 0.01 * earth.ARCSEC_TO_RAD
+    assert np.abs(e.att_n_rad).max() < 0.01 * units.ARCSEC_TO_RAD
     assert np.abs(e.vel_n_mps).max() < 1e-6
     assert np.all(o["index_fault"] == 0) and o["index_fallbacks"][-1] == 0
     assert np.count_nonzero(o["index_state"] == 2) > 100
@@ -81,7 +81,7 @@ def test_text_progress_draws_on_a_terminal():
 
 
 
-HDRIFT = sim.SensorErrors(gyro_bias=np.array([1.0, 1.0, 0.0]) * 0.003 * earth.DPH_TO_RPS)
+HDRIFT = sim.SensorErrors(gyro_bias=np.array([1.0, 1.0, 0.0]) * 0.003 * units.DPH_TO_RPS)
 #: (scheme, index_sums) -> what it is
 VARIANTS = {(0, 0): "no rotation", (2, 0): "traditional", (4, 0): "flexible (literal)",
             (6, 0): "flexible, derivation form", (6, 1): "derivation form, turns summed"}
@@ -92,9 +92,9 @@ def _worst(m, hours, variants):
     for s, sums in variants:
         res = fil.run_fil(m, int(hours * 360_000), config=dict(index_scheme=s, index_sums=sums),
                           errors=HDRIFT, every=100)
-        worst[(s, sums)] = runner.nav_errors(res).horizontal_m.max()
+        worst[(s, sums)] = metrics.nav_errors(res).horizontal_m.max()
     print(f"\n{hours:g} h max horizontal error, nmi: " +
-          ", ".join(f"{VARIANTS[k]} {v / earth.NMI_TO_M:.3f}" for k, v in worst.items()))
+          ", ".join(f"{VARIANTS[k]} {v / units.NMI_TO_M:.3f}" for k, v in worst.items()))
     return worst
 
 

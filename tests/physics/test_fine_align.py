@@ -10,12 +10,13 @@ gives no latitude: we use 34.246 N (Xi'an, where its authors work; also seed
 import numpy as np
 import pytest
 
-from pyins import analysis, runner, sim
+from pyins import analysis, metrics, runner, sim
 from pyins.reference import attitude, earth
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
-DPH = earth.DPH_TO_RPS
+DEG = units.DEG_TO_RAD
+ARCMIN = units.ARCMIN_TO_RAD
+DPH = units.DPH_TO_RPS
 LAT = 34.246 * DEG
 EULER = np.array([-5.0, 2.0, 235.0]) * DEG
 N = 120_000                                  # 1200 s at 100 Hz
@@ -27,7 +28,7 @@ def run_seed001(states, seed, errors=None, phi0=np.array([10.0, 10.0, 60.0]) * A
     errors = errors if errors is not None else sim.preset("seed001")
     res = runner.navigate(m, N, every=1000, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(euler_b_rad=guess, fine_ticks=N, fine_states=states, **cfg))
-    return res, runner.nav_errors(res), analysis.alignment_limits(LAT, EULER, errors.gyro_bias,
+    return res, metrics.nav_errors(res), analysis.alignment_limits(LAT, EULER, errors.gyro_bias,
                                                                   errors.accel_bias)
 
 

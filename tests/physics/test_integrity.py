@@ -14,14 +14,14 @@ import sys
 import numpy as np
 import pytest
 
-from pyins import native, runner, sim
-from pyins.reference import earth
+from pyins import native, scenario, sim
+from pyins import units
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools", "papers"))
 from reproduce_seed000 import sensors  # noqa: E402
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
+DEG = units.DEG_TO_RAD
+ARCMIN = units.ARCMIN_TO_RAD
 LAT, LON = 34.246 * DEG, 108.910 * DEG
 INCONSISTENT = native.lib.PYINS_FAULT_ALIGN_INCONSISTENT
 UNSETTLED = native.lib.PYINS_FAULT_COARSE_UNSETTLED
@@ -31,7 +31,7 @@ def run(m, seconds, seed=3, lever_known=True, **align):
     n = seconds * 100
     dtheta, dv, _ = sim.exact_increments(m, n)
     dtheta, dv = sensors(seed=seed)[0].apply(dtheta, dv)
-    cfg = runner.initial_config(m, None, euler_b_rad=[0.0, 0.0, 0.0], **align)
+    cfg = scenario.initial_config(m, None, euler_b_rad=[0.0, 0.0, 0.0], **align)
     if not lever_known:
         cfg["lever_b_m"] = np.zeros(3)
     rec = native.Firmware(cfg).run(native.make_samples(dtheta, dv), every=100)

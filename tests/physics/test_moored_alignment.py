@@ -9,15 +9,16 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from pyins import native, runner, sim
+from pyins import native, scenario, sim
 from pyins.reference import coarse_align, earth
+from pyins import units
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools"))
 import derive_coarse_fit  # noqa: E402
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
+DEG = units.DEG_TO_RAD
+ARCMIN = units.ARCMIN_TO_RAD
+ARCSEC = units.ARCSEC_TO_RAD
 LAT, LON = 34.246 * DEG, 108.910 * DEG
 
 
@@ -64,7 +65,7 @@ def _align(m, method, seconds, sensors=None, lever_known=True):
     dtheta, dv, _ = sim.exact_increments(m, n)
     if sensors is not None:
         dtheta, dv = sensors.apply(dtheta, dv)
-    cfg = runner.initial_config(m, None, coarse_ticks=n, coarse_method=method,
+    cfg = scenario.initial_config(m, None, coarse_ticks=n, coarse_method=method,
                                 coarse_output_every_ticks=200, euler_b_rad=[0.0, 0.0, 0.0])
     if not lever_known:
         cfg["lever_b_m"] = np.zeros(3)

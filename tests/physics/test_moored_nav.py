@@ -6,11 +6,11 @@ must not hide here."""
 import numpy as np
 import pytest
 
-from pyins import fil, runner, sim
-from pyins.reference import earth
+from pyins import fil, metrics, sim
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
+DEG = units.DEG_TO_RAD
+ARCSEC = units.ARCSEC_TO_RAD
 XIAN = (34.246 * DEG, 108.910 * DEG, 380.0)
 LEVER = (0.5, 1.5, 1.2)     # 1.98 m: the built-in moored ship's
 
@@ -31,7 +31,7 @@ def test_24h_error_free_moored_ship_with_lever_arm(scheme):
     # A lever velocity left out is a Schuler oscillation of hundreds of
     # metres; a lever arm not removed from the output is ~1.6 m (below).
     res = fil.run_fil(ship(), 24 * 360_000, config=dict(index_scheme=scheme), every=1000)
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     assert e.horizontal_m.max() < 1.0
     assert np.abs(e.att_n_rad).max() < 0.1 * ARCSEC
     assert res.outputs["fault_flags"][-1] == 0
@@ -43,5 +43,5 @@ def test_unknown_lever_arm_shows_as_position_error():
     # reference point. This is what the 24 h test would see if the output
     # were not moved to the reference point.
     res = fil.run_fil(ship(), 360_000, config=dict(lever_b_m=[0.0, 0.0, 0.0]), every=1000)
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     assert e.horizontal_m.max() > 1.0

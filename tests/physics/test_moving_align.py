@@ -8,15 +8,15 @@ import sys
 import numpy as np
 import pytest
 
-from pyins import native, runner, sim
-from pyins.reference import earth
+from pyins import native, scenario, sim
+from pyins import units
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "tools", "papers"))
 from reproduce_seed000 import limit_euler, sensors  # noqa: E402
 
-DEG = earth.DEG_TO_RAD
-ARCMIN = earth.ARCMIN_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
+DEG = units.DEG_TO_RAD
+ARCMIN = units.ARCMIN_TO_RAD
+ARCSEC = units.ARCSEC_TO_RAD
 LAT, LON = 34.246 * DEG, 108.910 * DEG
 
 
@@ -27,7 +27,7 @@ def align(m, seed=None, **extra):
     if seed is not None:
         model, errs = sensors(seed=seed)
         dtheta, dv = model.apply(dtheta, dv)
-    cfg = runner.initial_config(m, None, coarse_ticks=12000, coarse_method=1, fine_ticks=48000,
+    cfg = scenario.initial_config(m, None, coarse_ticks=12000, coarse_method=1, fine_ticks=48000,
                                 fine_states=12, euler_b_rad=[0.0, 0.0, 0.0], **extra)
     rec = native.Firmware(cfg).run(native.make_samples(dtheta, dv), every=1000)
     truth = sim.truth_at(m, rec["tick"][-1:])

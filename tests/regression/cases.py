@@ -10,10 +10,10 @@ alignment grids and stops, so every mode and every branch of a scheme runs.
 """
 import numpy as np
 
-from pyins import native, runner, sim
-from pyins.reference import earth
+from pyins import native, scenario, sim
+from pyins import units
 
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 LAT, LON, HEIGHT = 34.246 * DEG, 108.910 * DEG, 380.0
 N_TICKS = 2500
 #: Stored records: every this many ticks, plus a SHA-256 over every tick's record.
@@ -75,7 +75,7 @@ def inputs(name):
     if preset is not None:
         model = sim.SensorModel(sim.preset(preset), seed=sum(map(ord, name)))
         dtheta, dv = model.apply(dtheta, dv)
-    cfg = runner.initial_config(m, None, **overrides)
+    cfg = scenario.initial_config(m, None, **overrides)
     seq = np.arange(1, N_TICKS + 1, dtype=np.int64)
     if faults:
         seq[700:] += 1            # one tick missing in fine alignment (restart)

@@ -11,13 +11,14 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from pyins import runs, scenario, sim
-from pyins.reference import attitude, earth
+from pyins import metrics, runs, scenario, sim
+from pyins.reference import attitude
 from pyins.scenario import ScenarioError
 from pyins.units import UNITS, parse_quantity
+from pyins import units
 
 ROOT = Path(__file__).resolve().parents[2]
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001_fine8",
             "seed002_exp1", "seed002_exp2", "seed003",
             "moored_bad", "moored_general", "moored_ideal", "moored_spectrum"]   # test_scenario_ship.py
@@ -99,7 +100,7 @@ def test_seed002_builtins_match_reproduce_seed002():
             assert r.table.accel_max_rad_s2 == tool.PLANT_ACCEL
             assert_same_config(r.config, want)
             assert r.seed == 1 and r.duration_ticks == int(72.0 * 360_000)
-        paper = [f["value_si"] / earth.NMI_TO_M for f in sc.paper["figures"]]
+        paper = [f["value_si"] / units.NMI_TO_M for f in sc.paper["figures"]]
         assert paper == pytest.approx(tool.PAPER[exp], rel=1e-12)
 
 
@@ -113,9 +114,9 @@ def test_seed003_builtin_matches_reproduce_seed003():
         assert r.seed == 1 and r.duration_ticks == int(24.0 * 360_000)
     figs = {f["metric"]: f for f in scenario.load("seed003").paper["figures"]}
     assert figs["horizontal_error_max"]["value_si"] == pytest.approx(
-        tool.PAPER["position_nmi"] * earth.NMI_TO_M)
+        tool.PAPER["position_nmi"] * units.NMI_TO_M)
     assert figs["level_error_max"]["value_si"] == pytest.approx(
-        tool.PAPER["level_arcmin"] * earth.ARCMIN_TO_RAD)
+        tool.PAPER["level_arcmin"] * units.ARCMIN_TO_RAD)
     assert figs["velocity_error_max"]["relation"] == "<"
 
 
@@ -180,7 +181,7 @@ def test_resolved_is_si_and_json_round_trips():
     sc = scenario.loads(MINIMAL + 'lat = "45 deg"\n[sensors]\ngyro_bias = "0.01 deg/h"\n')
     res = sc.resolved()
     assert res["duration_s"] == 3600.0 and res["motion"]["lat_rad"] == 45.0 * DEG
-    assert res["sensors"]["gyro_bias_rad_s"] == [0.01 * earth.DPH_TO_RPS] * 3
+    assert res["sensors"]["gyro_bias_rad_s"] == [0.01 * units.DPH_TO_RPS] * 3
     assert res["firmware"]["coarse_time_s"] is None          # the firmware's default
     assert json.loads(sc.resolved_json()) == res
 
@@ -225,7 +226,7 @@ def test_compare_over_any_key_and_default_labels():
                         'values = ["0.001 deg/h", "0.01 deg/h"]\n')
     runs = list(sc.runs())
     assert [r.label for r in runs] == ["sensors.gyro_bias = 0.001 deg/h", "sensors.gyro_bias = 0.01 deg/h"]
-    assert runs[1].errors.gyro_bias[0] == 0.01 * earth.DPH_TO_RPS
+    assert runs[1].errors.gyro_bias[0] == 0.01 * units.DPH_TO_RPS
     assert sc.resolved()["variants"][0]["label"] == runs[0].label
 
 
@@ -273,13 +274,13 @@ angle = "-180 deg"
 # ---------------------------------------------------------------------------
 def test_units_agree_with_the_earth_constants_and_presets():
     q = parse_quantity
-    assert q("1 deg", "angle") == earth.DEG_TO_RAD
-    assert q("1 arcmin", "angle") == q("1'", "angle") == earth.ARCMIN_TO_RAD
-    assert q("1 arcsec", "angle") == q('1"', "angle") == earth.ARCSEC_TO_RAD
-    assert q("1 deg/h", "angular_rate") == earth.DPH_TO_RPS
-    assert q("1 g", "acceleration") == earth.G0
-    assert q("1 ug", "acceleration") == q("1 µg", "acceleration") == earth.UG_TO_MPS2
-    assert q("1 nmi", "length") == earth.NMI_TO_M
+    assert q("1 deg", "angle") == units.DEG_TO_RAD
+    assert q("1 arcmin", "angle") == q("1'", "angle") == units.ARCMIN_TO_RAD
+    assert q("1 arcsec", "angle") == q('1"', "angle") == units.ARCSEC_TO_RAD
+    assert q("1 deg/h", "angular_rate") == units.DPH_TO_RPS
+    assert q("1 g", "acceleration") == units.G0
+    assert q("1 ug", "acceleration") == q("1 µg", "acceleration") == units.UG_TO_MPS2
+    assert q("1 nmi", "length") == units.NMI_TO_M
     # the preset values, bit for bit, from the way a file writes them
     p2 = sim.preset("seed002")
     assert q("0.003 deg/h", "angular_rate") == p2.gyro_bias[0]
@@ -296,7 +297,7 @@ def test_unit_spellings():
     assert q("6 deg / s", "angular_rate") == q("6deg/s", "angular_rate") == q("6 °/s", "angular_rate")
     assert q("1 m/s²", "acceleration") == q("1 m/s**2", "acceleration") == 1.0
     assert q("2 deg/√h", "angle_random_walk") == q("2 deg/sqrt(h)", "angle_random_walk")
-    assert q("5 ug/sqrt(hz)", "velocity_random_walk") == 5 * earth.UG_TO_MPS2
+    assert q("5 ug/sqrt(hz)", "velocity_random_walk") == 5 * units.UG_TO_MPS2
     assert q("+1.5e-3 h", "time") == 5.4 and q(".5 min", "time") == 30.0
     assert q("150 ticks", "time", tick_hz=100) == 1.5
     assert q(0, "time") == 0.0 and q(0.25, "dimensionless") == 0.25 and q("1 %", "dimensionless") == 0.01
@@ -484,7 +485,6 @@ def test_smoke_builtin_run_equals_the_reproduce_tool_run():
     """The flexible run of seed002_exp1, shortened to 500 ticks, through
     fil.run_fil: bit-identical to the run tools/papers/reproduce_seed002.py starts."""
     fil = pytest.importorskip("pyins.fil")
-    from pyins import runner
     tool = _tool("reproduce_seed002")
     sc = scenario.load("seed002_exp1").with_overrides({"duration": "5 s", "record_every": "0.5 s"})
     run = list(sc.runs())[2]
@@ -495,5 +495,5 @@ def test_smoke_builtin_run_equals_the_reproduce_tool_run():
                          errors=sim.preset("seed002"), seed=1, every=50)
     assert len(ours.outputs) == 10
     assert ours.outputs.tobytes() == theirs.outputs.tobytes()
-    e = runner.nav_errors(ours)
+    e = metrics.nav_errors(ours)
     assert np.all(np.isfinite(e.horizontal_m)) and e.horizontal_m[0] == pytest.approx(10 * math.sqrt(2), rel=1e-3)

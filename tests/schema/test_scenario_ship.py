@@ -10,12 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyins import runner, runs, scenario, sim
+from pyins import runs, scenario, sim
 from pyins.reference import earth
 from pyins.scenario import ScenarioError
+from pyins import units
 
 ROOT = Path(__file__).resolve().parents[2]
-DEG = earth.DEG_TO_RAD
+DEG = units.DEG_TO_RAD
 METHODS = {"triad": 0, "fit": 1}      # pyins_coarse_method
 MOORED = ["moored_bad", "moored_general", "moored_ideal", "moored_spectrum"]
 SEEDS_PAPERS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001_fine8",
@@ -72,8 +73,8 @@ def test_moored_builtins_match_sim_moored_and_the_tool():
             assert_same_errors(r.errors, tool.sensors(seed=r.seed)[1])
             assert r.seed == 7 + 1000 * 240 + 0 and r.duration_ticks == 30_000
             # the configuration the firmware gets is the tool's (run_case), bit for bit
-            ours = runner.initial_config(r.motion, None, **r.config)
-            theirs = runner.initial_config(m, None, coarse_ticks=30_000, coarse_method=METHODS[method],
+            ours = scenario.initial_config(r.motion, None, **r.config)
+            theirs = scenario.initial_config(m, None, coarse_ticks=30_000, coarse_method=METHODS[method],
                                            coarse_output_every_ticks=200, euler_b_rad=[0.0, 0.0, 0.0])
             assert set(ours) - set(theirs) == {"index_scheme", "coarse_ratio"}
             assert ours["index_scheme"] == 0 and ours["coarse_ratio"] == 0.5
@@ -167,15 +168,15 @@ def test_the_firmware_gets_the_reference_point_and_the_lever_as_told():
     assert r.config["lat_rad"] == ref.lat[0] + 5.0 / rm != imu.lat[0] + 5.0 / rm
     assert np.array_equal(r.config["vel_n_mps"], ref.vel_n[0] + np.array([0.1, 0.0, 0.0]))
     assert not np.allclose(ref.vel_n[0], imu.vel_n[0])          # the lever arm turns with the ship
-    assert "lever_b_m" not in r.config                           # runner.initial_config adds the motion's
-    full = runner.initial_config(r.motion, None, **r.config)
+    assert "lever_b_m" not in r.config                           # scenario.initial_config adds the motion's
+    full = scenario.initial_config(r.motion, None, **r.config)
     assert np.array_equal(full["lever_b_m"], [3.0, 20.0, 5.0]) and np.array_equal(full["lever_p_m"], [0, 0, 0])
     assert full["height_m"] == ref.height[0] and full["lon_rad"] == ref.lon[0]
     # unknown: the firmware is told no lever arm, the plant keeps it
     (u,) = scenario.loads(BASE + ship + errs + '[firmware]\nlever = "unknown"\ncoarse_method = "fit"\n').runs()
     assert u.config["lever_b_m"] == [0.0] * 3 and u.config["lever_p_m"] == [0.0] * 3
     assert u.config["coarse_method"] == 1 and np.array_equal(u.motion.lever_b, [3.0, 20.0, 5.0])
-    assert np.array_equal(runner.initial_config(u.motion, None, **u.config)["lever_b_m"], [0, 0, 0])
+    assert np.array_equal(scenario.initial_config(u.motion, None, **u.config)["lever_b_m"], [0, 0, 0])
     (t,) = scenario.loads(BASE + '[firmware]\ncoarse_method = "triad"\n').runs()
     assert t.config["coarse_method"] == 0
     # compare and overrides reach the new keys

@@ -8,8 +8,9 @@ from pyins.sim import motion as M
 from pyins.sim import turntable as T
 from pyins.sim.sensors import SensorModel, preset
 from pyins.units import DT
+from pyins import units
 
-D = earth.DEG_TO_RAD
+D = units.DEG_TO_RAD
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
 
 

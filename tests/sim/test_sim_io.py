@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from pyins.sim import io
+from pyins.sim import imu, io, motion, turntable
 
 
 def sample_arrays(n=500, seed=0):
@@ -53,9 +53,8 @@ def test_csv_round_trip(tmp_path):
 
 
 def test_csv_of_simulated_run(tmp_path):
-    from pyins.sim import imu, motion
     mo = motion.sea_state("bad", 0.5, 2.0, 0.0, 0.3)
-    th, dv, angle = imu.exact_increments(mo, 300, table=motion.ConstantRate(0.1))
+    th, dv, angle = imu.exact_increments(mo, 300, table=turntable.ConstantRate(0.1))
     io.save_csv(tmp_path / "a.csv", th, dv, angle)
     data = io.load_csv(tmp_path / "a.csv")
     assert same_bits(data.dtheta_p, th) and same_bits(data.dv_p, dv)

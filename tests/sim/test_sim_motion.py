@@ -8,8 +8,9 @@ from scipy.integrate import solve_ivp
 from pyins.reference import earth
 from pyins.sim import motion as M
 from pyins.sim import turntable as T
+from pyins import units
 
-D = earth.DEG_TO_RAD
+D = units.DEG_TO_RAD
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
 
 

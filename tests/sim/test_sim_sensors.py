@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from pyins.reference import earth
 from pyins.sim import sensors as S
 from pyins.units import DT
+from pyins import units
 
 
 
@@ -103,7 +103,7 @@ def test_chunked_equals_one_shot_and_seeds():
 def test_presets_values():
     # Unit conversions against independently written literals (rtol 1e-15:
     # a couple of roundings); a deg/h vs deg/sqrt(h) mix-up is off by 60x.
-    dph, ug, asec = earth.DPH_TO_RPS, earth.UG_TO_MPS2, earth.ARCSEC_TO_RAD
+    dph, ug, asec = units.DPH_TO_RPS, units.UG_TO_MPS2, units.ARCSEC_TO_RAD
     e0 = S.preset("error_free")
     assert np.all(e0.gyro_bias == 0) and e0.gyro_arw == 0 and e0.accel_vrw == 0
     e = S.preset("seed000")

@@ -6,16 +6,17 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from pyins import fil, runner, sim
+from pyins import fil, metrics, runner, sim
 from pyins.reference import earth
 from pyins.sim import imu
 from pyins.sim import motion as M
 from pyins.sim import turntable as T
 from pyins.sim import ship as S
 from pyins.units import DT
+from pyins import units
 
-D = earth.DEG_TO_RAD
-ARCSEC = earth.ARCSEC_TO_RAD
+D = units.DEG_TO_RAD
+ARCSEC = units.ARCSEC_TO_RAD
 LAT, LON, HEIGHT = 30.0 * D, 120.0 * D, 100.0
 XIAN = (34.246 * D, 108.910 * D)      # seed 002's site, as tests/physics/test_error_free_nav.py
 
@@ -303,7 +304,7 @@ def _errors_at_imu(motion, table=None, config=None):
                    vel_n_mps=st0.vel_n[0], euler_b_rad=st0.euler[0])
     cfg.update(config or {})
     res = runner.navigate(motion, 360_000, every=100, table=table, config=cfg)
-    e = runner.nav_errors(runner.RunResult(res.outputs, imu_view(res.truth), res.dt))
+    e = metrics.nav_errors(runner.RunResult(res.outputs, imu_view(res.truth), res.dt))
     up = res.outputs["height_m"] - res.truth.imu_height
     return res, e, up
 
@@ -344,7 +345,7 @@ def test_firmware_navigates_the_heaving_imu_point_1h():
     assert np.abs(e.vel_n_mps).max() < 1e-3
     assert np.abs(e.att_n_rad).max() < 0.01 * ARCSEC     # as test_error_free_nav
     # the comparison has teeth: against the reference point the error is the lever arm
-    e_ref = runner.nav_errors(res)
+    e_ref = metrics.nav_errors(res)
     print(f"against the reference point: {e_ref.horizontal_m.max():.2f} m")
     assert e_ref.horizontal_m.max() > 1.0
 
@@ -370,7 +371,7 @@ def test_fil_plant_runs_a_moored_ship_like_the_open_loop():
     # once per period (12000 ticks) and turns them itself: with the table at
     # rest it must match runner.navigate to rounding (measured 4e-14 rad).
     ship = S.moored("general", *XIAN, 0.0, 240.0 * D)
-    assert fil.periodic_ticks(ship, DT) == 12000
+    assert sim.periodic_ticks(ship, DT) == 12000
     a = fil.run_fil(ship, 60_000, every=100)
     b = runner.navigate(ship, 60_000, every=100)
     assert np.max(np.abs(a.outputs["lat_rad"] - b.outputs["lat_rad"])) < 1e-12   # 6 um
@@ -383,21 +384,21 @@ def test_periodic_ticks_of_ship_at_sea():
     lin = S.LinearMotion(heave=[(0.5, 8.0, 0.0)], surge=[(0.3, 12.0, 0.0)], sway=[(0.3, 10.0, 0.0)])
     gen = M.sea_state("general", LAT, LON, HEIGHT, 0.0)         # 8 s and 5 s
     # lcm(800, 500, 500, 800, 1200, 1000) ticks = 12000 ticks = 120 s
-    assert fil.periodic_ticks(S.ShipAtSea(gen, lin), DT) == 12000
+    assert sim.periodic_ticks(S.ShipAtSea(gen, lin), DT) == 12000
     # bad: 0.2 Hz (500 ticks) and 0.3 Hz (3 cycles = 1000 ticks) -> 12000 too
-    assert fil.periodic_ticks(S.ShipAtSea(bad_sea(), lin, lever_b=(1, 2, 3)), DT) == 12000
+    assert sim.periodic_ticks(S.ShipAtSea(bad_sea(), lin, lever_b=(1, 2, 3)), DT) == 12000
     static = M.Static(LAT, LON, HEIGHT)
-    assert fil.periodic_ticks(S.ShipAtSea(static), DT) == 1
-    assert fil.periodic_ticks(S.ShipAtSea(static, S.LinearMotion(heave=[(1, 7.5, 0)])), DT) == 750
+    assert sim.periodic_ticks(S.ShipAtSea(static), DT) == 1
+    assert sim.periodic_ticks(S.ShipAtSea(static, S.LinearMotion(heave=[(1, 7.5, 0)])), DT) == 750
     # an irrational-looking period (not whole ticks in 1000 cycles) -> None
-    assert fil.periodic_ticks(S.ShipAtSea(static, S.LinearMotion(heave=[(1, np.pi, 0)])), DT) is None
+    assert sim.periodic_ticks(S.ShipAtSea(static, S.LinearMotion(heave=[(1, np.pi, 0)])), DT) is None
     # a spectrum: every period is whole ticks, but the LCM exceeds any run -> None
     spec = S.named_sea_spectrum("moored_moderate")
     for p in spec.periods:
         assert abs(p / DT - round(p / DT)) < 1e-9 * p / DT
-    assert fil.periodic_ticks(S.ShipAtSea(gen, spec), DT) is None
+    assert sim.periodic_ticks(S.ShipAtSea(gen, spec), DT) is None
     # the swing path is unchanged
-    assert fil.periodic_ticks(gen, DT) == 4000
+    assert sim.periodic_ticks(gen, DT) == 4000
 
 
 # --- spectra ---------------------------------------------------------------------

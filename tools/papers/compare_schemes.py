@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, runner, sim
+from pyins import analysis, fil, metrics, progress, sim
 from pyins.sim import motion
 from pyins.sim.turntable import TableConfig
 from pyins.units import DEG_TO_RAD as DEG
@@ -54,7 +54,7 @@ def run_one(m, scheme, sums, accel_deg, hours, progress):
     res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), errors=errors, every=TICK_HZ,
                       config=dict(index_scheme=scheme, index_sums=sums, index_accel_rad_s2=accel_deg * DEG),
                       table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress)
-    e = runner.nav_errors(res)
+    e = metrics.nav_errors(res)
     return {"max_nmi": float(e.horizontal_m.max() / NMI_TO_M),
             "final_nmi": float(e.horizontal_m[-1] / NMI_TO_M),
             "survives": analysis.drift_surviving(res.outputs["yaw_p_rad"]),
@@ -68,7 +68,7 @@ def main(argv=None):
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    progress = None if args.quiet else fil.TextProgress()
+    progress = None if args.quiet else progress.TextProgress()
     out = {"hours": args.hours, "gyro_drift_deg_h": 0.003}
     head = "| ship | " + " | ".join(v[3] for v in VARIANTS) + " |"
     rows = [f"Max horizontal error [nmi] over {args.hours:g} h, horizontal gyro drifts only "

@@ -33,7 +33,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reproduce_seed000 import HEADINGS, LAT, LON, limit_euler, sensors  # noqa: E402
 
-from pyins import native, runner, sim  # noqa: E402
+from pyins import native, scenario, sim  # noqa: E402
 from pyins.units import ARCMIN_TO_RAD as ARCMIN  # noqa: E402
 from pyins.units import ARCSEC_TO_RAD as ARCSEC  # noqa: E402
 from pyins.units import DEG_TO_RAD as DEG  # noqa: E402
@@ -65,7 +65,7 @@ def wrap(a):
 
 def run_case(m, exact, model, align, lever_known):
     dtheta, dv = model.apply(*exact)
-    cfg = runner.initial_config(m, None, euler_b_rad=[0.0, 0.0, 0.0], **align)
+    cfg = scenario.initial_config(m, None, euler_b_rad=[0.0, 0.0, 0.0], **align)
     if not lever_known:
         cfg["lever_b_m"] = np.zeros(3)
         cfg["lever_p_m"] = np.zeros(3)

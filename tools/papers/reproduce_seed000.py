@@ -29,7 +29,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, runner, sim
+from pyins import analysis, metrics, runner, sim
 from pyins.reference.config import DEFAULT_COARSE_FIRST_S
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import ARCSEC_TO_RAD as ARCSEC
@@ -60,7 +60,7 @@ def align(m, seconds, model, ratio=0.5):
     n = int(seconds * TICK_HZ)
     res = runner.navigate(m, n, every=TICK_HZ, sensors=model,
                           config=dict(coarse_ticks=n, coarse_ratio=ratio, euler_b_rad=[0.0, 0.0, 0.0]))
-    return res, runner.nav_errors(res)
+    return res, metrics.nav_errors(res)
 
 
 def euler_errors(res, k=-1):

@@ -21,7 +21,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, runner, sim
+from pyins import analysis, metrics, runner, sim
 from pyins.reference import attitude
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
@@ -42,7 +42,7 @@ def run(states, seed):
     res = runner.navigate(m, N, every=TICK_HZ, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(euler_b_rad=guess, fine_ticks=N, fine_states=states))
     lim = analysis.alignment_limits(LAT, EULER, errors.gyro_bias, errors.accel_bias)
-    return res, runner.nav_errors(res), lim
+    return res, metrics.nav_errors(res), lim
 
 
 def eps_estimates(out, states):

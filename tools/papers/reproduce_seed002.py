@@ -32,7 +32,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, runner, scenario, sim
+from pyins import analysis, fil, metrics, progress, scenario, sim
 from pyins.sim.turntable import TableConfig
 from pyins.units import ARCSEC_TO_RAD as ARCSEC
 from pyins.units import DEG_TO_RAD as DEG
@@ -85,8 +85,8 @@ def run_one(exp, scheme, sums, errors, with_init, accel, hours, seed):
         cfg.update(initial_errors(m))
     res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), config=cfg, errors=errors, seed=seed,
                       every=TICK_HZ,
-                      table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=fil.TextProgress())
-    e = runner.nav_errors(res)
+                      table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress.TextProgress())
+    e = metrics.nav_errors(res)
     psi = res.outputs["yaw_p_rad"]
     # the proxy of docs/papers.md, seed 002 §10 (from the 1 Hz records), split into the stopped
     # and the turning part

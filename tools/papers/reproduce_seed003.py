@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, runner, sim
+from pyins import analysis, fil, metrics, progress, sim
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
 from pyins.units import NMI_TO_M, TICK_HZ
@@ -63,8 +63,8 @@ def main(argv=None):
     up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
     for scheme, label in ((0, "no rotation"), (1, "single-position fwd/rev (seed 003)")):
         res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed,
-                          every=TICK_HZ, progress=fil.TextProgress())
-        e = runner.nav_errors(res)
+                          every=TICK_HZ, progress=progress.TextProgress())
+        e = metrics.nav_errors(res)
         # error theory with the same constant drifts and biases, and split by source
         theory = {
             "all constant errors": analysis.predict_static_fil(res, lat, zero3, errors.gyro_bias,
@@ -81,7 +81,7 @@ def main(argv=None):
         res_b = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), seed=args.seed, every=TICK_HZ,
                             errors=sim.SensorErrors(gyro_bias=errors.gyro_bias,
                                                     accel_bias=errors.accel_bias))
-        rows.append((f"ours, {label}, constant drifts and biases only", figures(runner.nav_errors(res_b))))
+        rows.append((f"ours, {label}, constant drifts and biases only", figures(metrics.nav_errors(res_b))))
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_biases_only_max_{k}"] = float(v)
         for what, th_err in theory.items():
