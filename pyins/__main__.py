@@ -25,9 +25,10 @@ import time
 
 import numpy as np
 
-from pyins import __version__, bench, campaign, engine, logs, metrics, native, report, runner, runs, scenario, sim
+from pyins import (__version__, bench, campaign, engine, limits, logs, metrics, native, report, runner, runs,
+                   scenario, sim, units)
 from pyins.progress import TextProgress
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DT, NMI_TO_M, TICK_HZ
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DT, NMI_TO_M, TICK_HZ, ScenarioError
 
 _TICKS_PER_HOUR = 3600 * TICK_HZ
 
@@ -99,6 +100,7 @@ def _demo(args):
 
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_BROKEN_PIPE = 141          #: 128 + SIGPIPE, as a shell reports a command its reader left
 
 
 class InputError(Exception):
@@ -222,6 +224,52 @@ def cmd_simulate(args):
     return EXIT_OK
 
 
+#: How the replay command names the firmware fields it sets (`pyins.limits`).
+_REPLAY_NAMES = {"tick_hz": "--rate", "lat_rad": "--lat", "lon_rad": "--lon", "height_m": "--height",
+                 "euler_b_rad": "--attitude", "coarse_ticks": "--coarse",
+                 "coarse_output_every_ticks": "--coarse-every", "coarse_method": "--coarse-method",
+                 "fine_ticks": "--fine", "fine_states": "--fine-states",
+                 "fine_gyro_arw": "--gyro-arw", "fine_accel_vrw": "--accel-vrw",
+                 "fine_sigma0_att_rad": "--fine-sigma0"}
+
+
+def _replay_rate(args, data, spec):
+    """The log's sample rate [Hz] as the firmware's whole-number tick rate:
+    from the log (its time column, its dt, or --dt), else --rate, else the
+    scenario's; any two that disagree by more than 1 % are an error."""
+    rate, where = None, None
+    if data.dt:
+        rate, where = 1.0 / data.dt, ("--dt" if args.dt is not None else f"the log ({args.log})")
+    if args.rate is not None:
+        if not args.rate > 0:
+            raise InputError(f"--rate: {args.rate:g} Hz must be positive")
+        if rate is not None and abs(args.rate - rate) > 0.01 * rate:
+            raise InputError(f"--rate {args.rate:g} Hz disagrees with {where}: {rate:.6g} Hz")
+        rate, where = float(args.rate), "--rate"
+    if spec is not None:
+        scn_rate = 1.0 / spec.dt
+        if rate is not None and abs(scn_rate - rate) > 0.01 * rate:
+            raise InputError(f"{where} gives {rate:.6g} Hz, the scenario {spec.scenario!r} runs at "
+                             f"{scn_rate:g} Hz: its truth would not fit the log")
+        if rate is None:
+            rate, where = scn_rate, f"the scenario {spec.scenario!r}"
+    if rate is None:
+        raise InputError(f"{args.log}: no sample rate: the log has no time column or dt; give --rate HZ")
+    hz = int(round(rate))
+    # 1 ns: the reader rounds an inferred tick to it
+    if hz < 1 or abs(1.0 / hz - 1.0 / rate) > 1e-9 + 1e-6 / rate:
+        raise InputError(f"{where}: {rate:.9g} Hz is not a whole number of Hz; the firmware steps at an "
+                         "integer tick rate (resample the log)")
+    return hz
+
+
+def _quantity(option, text, dimension):
+    try:
+        return units.parse_quantity(text, dimension)
+    except ScenarioError as exc:
+        raise InputError(f"{option} {text!r}: {exc.reason}") from None
+
+
 def cmd_replay(args):
     read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
                    axes=args.axes, time_col=args.time_col)
@@ -239,6 +287,10 @@ def cmd_replay(args):
         specs = list(scn.runs())
         spec = specs[int(data.metadata.get("variant", 0)) if not args.scenario else 0]
         cfg = runs.replay_config(spec)
+
+    # 1. the rate, the initial state and the firmware options, each as the user gave it
+    hz = _replay_rate(args, data, spec)
+    cfg["tick_hz"] = hz
     for name, val in (("lat_rad", args.lat), ("lon_rad", args.lon)):
         if val is not None:
             cfg[name] = np.radians(val)
@@ -246,20 +298,56 @@ def cmd_replay(args):
         cfg["height_m"] = args.height
     if args.attitude is not None:
         cfg["euler_b_rad"] = np.radians(args.attitude)
-    if args.coarse is not None:
-        cfg["coarse_ticks"] = int(round(args.coarse / (data.dt or DT)))
-    if args.fine is not None:
-        cfg["fine_ticks"] = int(round(args.fine / (data.dt or DT)))
+    for option, field, val in (("--coarse", "coarse_ticks", args.coarse),
+                               ("--fine", "fine_ticks", args.fine),
+                               ("--coarse-every", "coarse_output_every_ticks", args.coarse_every)):
+        if val is not None:
+            if not (val >= 0 and np.isfinite(val)):
+                raise InputError(f"{option}: {val:g} s must be a time of zero or more seconds")
+            cfg[field] = int(round(val * hz))
+    if args.coarse_method is not None:
+        cfg["coarse_method"] = scenario.COARSE_METHODS[args.coarse_method]
+    if args.fine_states is not None:
+        cfg["fine_states"] = args.fine_states
+    if args.fine_correction is not None:
+        cfg["fine_correction"] = scenario.FINE_CORRECTIONS[args.fine_correction]
+    if args.vertical is not None:
+        cfg["vertical_mode"] = args.vertical
+    if args.fine_sigma0 is not None:
+        cfg["fine_sigma0_att_rad"] = [_quantity("--fine-sigma0", t, "angle") for t in args.fine_sigma0]
+    if args.gyro_arw is not None:
+        cfg["fine_gyro_arw"] = _quantity("--gyro-arw", args.gyro_arw, "angle_random_walk")
+    if args.accel_vrw is not None:
+        cfg["fine_accel_vrw"] = _quantity("--accel-vrw", args.accel_vrw, "velocity_random_walk")
+
+    # 2. what the firmware cannot be right without, refused before it runs
     if "lat_rad" not in cfg:
         raise InputError(f"{args.log}: no initial position: give --scenario or --lat/--lon/--height "
                          "(and --attitude, or --coarse to align)")
+    if "euler_b_rad" not in cfg and cfg.get("coarse_ticks", 0) <= 0:
+        raise InputError(f"{args.log}: no initial attitude: give --attitude PITCH ROLL YAW [deg], or "
+                         "--coarse SECONDS to align on the log (without either the firmware would start "
+                         "level and facing north)")
+    refused = limits.check(cfg, _REPLAY_NAMES)
+    if refused is not None:
+        raise InputError(refused[1])
+
+    # 3. the log through the firmware
     out_dir = args.out or _default_out("replay")
-    summary = runs.replay(data, cfg, out_dir, every=args.every, spec=spec, engine=args.engine,
+    every = args.every if args.every is not None else hz
+    summary = runs.replay(data, cfg, out_dir, every=every, spec=spec, engine=args.engine,
                           log_path=args.log)
-    _say(args, f"pyins replay {args.log}: {summary['samples']} samples -> {out_dir}/navigation.npz")
+    _say(args, f"pyins replay {args.log}: {summary['samples']} samples at {hz} Hz "
+               f"-> {out_dir}/navigation.npz")
+    if "aligned" in summary:
+        al = summary["aligned"]
+        _say(args, f"  aligned at {al['time_s']:g} s: pitch {al['pitch_deg']:.4f} deg, roll "
+                   f"{al['roll_deg']:.4f} deg, heading {al['heading_deg']:.4f} deg")
     fin = summary["final"]
     _say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, mode {fin['mode']}, "
                f"faults {fin['fault_flags']}")
+    for w in summary.get("warnings", ()):
+        print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     if "errors" in summary:
         er = summary["errors"]
         _say(args, f"  against the scenario's truth: max horizontal {er['horizontal_max_m']:.2f} m, "
@@ -346,7 +434,9 @@ EXAMPLES = {
     "simulate": "example:\n  pyins simulate demo imu.npz --hours 0.5\n  pyins simulate seed000_static imu.txt",
     "replay": "examples:\n  pyins replay imu.npz                       # initial state from the log's scenario\n"
               "  pyins replay field.txt --kind rates --gyro-unit deg/s --accel-unit g --axes frd \\\n"
-              "      --lat 34.246 --lon 108.91 --height 380 --coarse 150 --fine 600",
+              "      --lat 34.246 --lon 108.91 --height 380 --coarse 150 --fine 600\n"
+              "  pyins replay log200.txt --time-col first --axes frd --lat 34.246 --lon 108.91 \\\n"
+              "      --height 0 --coarse 300 --coarse-method fit   # the rate (200 Hz) from the time column",
     "report": "example:\n  pyins report runs/seed003",
     "campaign": "examples:\n  pyins campaign seed000_static\n"
                 "  pyins campaign --scenario seed000_static --grid motion.heading=\"0 deg,60 deg\" --seeds 5\n"
@@ -396,6 +486,8 @@ def build_parser():
     p.add_argument("--axes", help="axis mapping, e.g. frd or frd->rfu (default rfu)")
     p.add_argument("--time-col", choices=["first", "last", "none"])
     p.add_argument("--dt", type=float, help="sample interval [s] when the log has no time")
+    p.add_argument("--rate", type=float, help="sample rate [Hz]: checked against the log's time "
+                   "column (within 1 %%); needed when the log has neither time nor dt")
     p.add_argument("--table-angle", type=float, help="a fixed table angle [deg] for logs without one")
     p.add_argument("--lat", type=float, help="initial latitude [deg]")
     p.add_argument("--lon", type=float, help="initial longitude [deg]")
@@ -403,8 +495,19 @@ def build_parser():
     p.add_argument("--attitude", type=float, nargs=3, metavar=("PITCH", "ROLL", "YAW"),
                    help="initial attitude [deg] (yaw counter-clockwise = -heading)")
     p.add_argument("--coarse", type=float, help="coarse alignment time [s]")
+    p.add_argument("--coarse-method", choices=sorted(scenario.COARSE_METHODS),
+                   help="triad (default; at most 255 output intervals) or fit (no length limit)")
+    p.add_argument("--coarse-every", type=float, help="coarse output interval [s] (default 1 s)")
     p.add_argument("--fine", type=float, help="fine alignment time [s]")
-    p.add_argument("--every", type=int, default=100, help="record every N samples (default 100 = 1 s)")
+    p.add_argument("--fine-states", type=int, choices=(5, 8, 12),
+                   help="fine filter: 5 (default) or 8 states (static base), 12 (moored ship)")
+    p.add_argument("--fine-correction", choices=sorted(scenario.FINE_CORRECTIONS))
+    p.add_argument("--fine-sigma0", nargs=3, metavar=("E", "N", "U"),
+                   help="initial attitude sigmas of the fine filter, with units, e.g. 10\' 10\' 60\'")
+    p.add_argument("--gyro-arw", help="gyro noise the fine filter assumes, e.g. \"0.001 deg/sqrt(h)\"")
+    p.add_argument("--accel-vrw", help="accelerometer noise the fine filter assumes, e.g. \"10 ug/sqrt(Hz)\"")
+    p.add_argument("--vertical", choices=("hold", "free"), help="vertical channel (default hold)")
+    p.add_argument("--every", type=int, help="record every N samples (default: one a second)")
     p.add_argument("--out", help="output directory (default runs/replay)")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
                    help="the firmware: native (compiled, default) or reference (NumPy mirror)")
@@ -454,6 +557,12 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("pyins: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # the reader closed the pipe (`pyins list | head`): not an error of
+        # ours; stop writing, silence the interpreter's flush at exit
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except Exception as exc:   # one line for the user; --debug for the traceback
         if args.debug:
             raise

@@ -155,8 +155,9 @@ def status_str(code):
     return ffi.string(lib.pyins_status_str(int(code))).decode()
 
 
-def _as_float_array(name, value, tail):
-    """Check one input array: float64, shape (N,) + tail, C-contiguous.
+def _as_float_array(name, value, tail, contiguous=True):
+    """Check one input array: float64, shape (N,) + tail, C-contiguous
+    (unless ``contiguous`` is False: the caller copies it).
 
     Plain Python sequences are converted; NumPy arrays must already be right
     (cffi's from_buffer would reinterpret a wrong dtype silently).
@@ -174,7 +175,7 @@ def _as_float_array(name, value, tail):
     want = "(N,)" if not tail else f"(N, {', '.join(map(str, tail))})"
     if a.ndim != 1 + len(tail) or a.shape[1:] != tail:
         raise ValueError(f"{name}: shape is {a.shape}, expected {want}")
-    if not a.flags.c_contiguous:
+    if contiguous and not a.flags.c_contiguous:
         raise ValueError(f"{name}: array is not C-contiguous (use numpy.ascontiguousarray)")
     return a
 
@@ -186,10 +187,11 @@ def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None, seq=None):
     (N,) float64 [rad] or None for a table fixed at 0; seq: (N,) integers,
     the IMU's sample counter (taken modulo 2^32), or None for zeros. The core
     reads seq only with ``seq_mode=1`` (PYINS_SEQ_CHECK) in its configuration;
-    logs without a counter leave it off.
+    logs without a counter leave it off. The fields are copied, so views
+    (a column slice of a log, every other row) are fine.
     """
-    dtheta = _as_float_array("dtheta_p_rad", dtheta_p_rad, (3,))
-    dv = _as_float_array("dv_p_mps", dv_p_mps, (3,))
+    dtheta = _as_float_array("dtheta_p_rad", dtheta_p_rad, (3,), contiguous=False)
+    dv = _as_float_array("dv_p_mps", dv_p_mps, (3,), contiguous=False)
     n = dtheta.shape[0]
     if dv.shape[0] != n:
         raise ValueError(f"dv_p_mps: has {dv.shape[0]} rows but dtheta_p_rad has {n}")
@@ -197,7 +199,7 @@ def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None, seq=None):
     samples["dtheta_p_rad"] = dtheta
     samples["dv_p_mps"] = dv
     if table_angle_rad is not None:
-        table = _as_float_array("table_angle_rad", table_angle_rad, ())
+        table = _as_float_array("table_angle_rad", table_angle_rad, (), contiguous=False)
         if table.shape[0] != n:
             raise ValueError(f"table_angle_rad: has {table.shape[0]} rows but dtheta_p_rad has {n}")
         samples["table_angle_rad"] = table

@@ -35,7 +35,10 @@ from pyins import engine as engines
 from pyins import fil, metrics, native, records, runner, scenario, sim
 from pyins.metrics import group_metrics
 from pyins.records import CSV_MAX_ROWS
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD
+from pyins.reference import abi
+from pyins.reference.fine_align import PHI
+from pyins.reference.firmware import VALID_HEADING_SIGMA
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
 
 __all__ = ["execute", "run", "replay", "replay_config", "load_variant", "paper_rows", "slug",
            "group_metrics", "CHECKPOINT_S", "CSV_MAX_ROWS", "SUMMARY"]
@@ -170,6 +173,40 @@ def replay_config(spec):
     return cfg
 
 
+_FAULT_NAMES = {v: k[len("PYINS_FAULT_"):] for k, v in vars(abi).items()
+                if k.startswith("PYINS_FAULT_") and isinstance(v, int)}
+
+
+def _replay_warnings(recs, aligning, hz):
+    """What a replay's figures cannot be trusted for, in words: a log that
+    ended before the alignment did, an attitude the firmware does not call
+    valid, fault bits."""
+    out = []
+    last = recs[-1]
+    t = float(last["tick"] / hz)
+    if aligning and last["mode"] != abi.PYINS_MODE_NAVIGATE:
+        phase = {abi.PYINS_MODE_COARSE_ALIGN: "coarse", abi.PYINS_MODE_FINE_ALIGN: "fine"}.get(
+            int(last["mode"]), "the")
+        out.append(f"the log ended during {phase} alignment (at {t:g} s): no aligned attitude")
+    if not last["state_flags"] & abi.PYINS_STATE_ATT_VALID:
+        integrity = abi.PYINS_FAULT_ALIGN_INCONSISTENT | abi.PYINS_FAULT_COARSE_UNSETTLED
+        heading_sigma = float(last["kf_sigma"][PHI][2]) if last["kf_states"] else 0.0
+        if int(last["fault_flags"]) & integrity:
+            why = "an integrity test failed: the measurements do not fit the alignment's model"
+        elif heading_sigma > VALID_HEADING_SIGMA:
+            why = (f"the fine alignment left a heading sigma of {heading_sigma / ARCMIN_TO_RAD:.1f}', above "
+                   f"{VALID_HEADING_SIGMA / ARCMIN_TO_RAD:g}': align longer")
+        elif aligning:
+            why = "the alignment had not ended"
+        else:
+            why = "it is the configured guess"
+        out.append(f"the attitude at the end ({t:g} s) is not valid (ATT_VALID unset): {why}")
+    faults = [name for bit, name in sorted(_FAULT_NAMES.items()) if bit and int(last["fault_flags"]) & bit]
+    if faults:
+        out.append("fault bits set: " + ", ".join(faults))
+    return out
+
+
 def replay(data, cfg, out_dir, every=100, spec=None, engine="native", log_path=None):
     """Run a recorded IMU log (``data``: a pyins.sim.io.ImuData) through the
     firmware configured by ``cfg`` into ``out_dir``: navigation.npz (the
@@ -195,6 +232,15 @@ def replay(data, cfg, out_dir, every=100, spec=None, engine="native", log_path=N
                               lon_deg=float(np.degrees(recs["lon_rad"][-1])),
                               euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
                               mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
+    hz = cfg.get("tick_hz") or TICK_HZ
+    aligning = cfg.get("coarse_ticks", 0) > 0 or cfg.get("fine_ticks", 0) > 0
+    nav = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE)
+    if aligning and len(nav):
+        k = nav[0]
+        pitch, roll, yaw = np.degrees(recs["euler_b_rad"][k])
+        summary["aligned"] = dict(time_s=float(recs["tick"][k] / hz), pitch_deg=float(pitch),
+                                  roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)))
+    summary["warnings"] = _replay_warnings(recs, aligning, hz)
     if spec is not None:
         truth = sim.truth_at(spec.motion, recs["tick"], dt=spec.dt)
         e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=spec.dt))

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyins import native, sim
+from pyins import limits, native, sim
 from pyins.reference import attitude, earth
-from pyins.scenario.schema import (INDEX_SUMS, _COARSE_METHODS, _FINE_CORRECTIONS, _LINEAR_AXES,
-                                   _STEP_MOVES, _TABLE_FAULTS, _VERTICAL_MODES)
+from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, INDEX_SUMS, VERTICAL_MODES,
+                                   _LINEAR_AXES, _STEP_MOVES, _TABLE_FAULTS)
 from pyins.sim import turntable
 from pyins.units import DT, TICK_HZ, ScenarioError
 
@@ -166,7 +166,7 @@ def _firmware_config(res, motion):
     fw, ix, ie = res["firmware"], res["indexing"], res["initial_errors"]
     cfg = {"index_scheme": ix["scheme_number"]}
     if fw["vertical_mode"] is not None:
-        cfg["vertical_mode"] = _VERTICAL_MODES[fw["vertical_mode"]]
+        cfg["vertical_mode"] = VERTICAL_MODES[fw["vertical_mode"]]
     for name, c_name in (("coarse_time_s", "coarse_ticks"),
                          ("coarse_first_output_s", "coarse_first_output_ticks"),
                          ("coarse_output_every_s", "coarse_output_every_ticks"),
@@ -182,9 +182,9 @@ def _firmware_config(res, motion):
         if fw[name] is not None:
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
-        cfg["fine_correction"] = _FINE_CORRECTIONS[fw["fine_correction"]]
+        cfg["fine_correction"] = FINE_CORRECTIONS[fw["fine_correction"]]
     if fw.get("coarse_method") is not None:
-        cfg["coarse_method"] = _COARSE_METHODS[fw["coarse_method"]]
+        cfg["coarse_method"] = COARSE_METHODS[fw["coarse_method"]]
     if fw.get("lever") == "unknown":
         # what an unknown lever arm costs: the firmware navigates the reference point as if
         # the accelerometers were there (initial_config would give it the motion's)
@@ -247,13 +247,26 @@ _STATUS_KEYS = {
 }
 
 
+#: the firmware fields as a scenario file names them (`pyins.limits`)
+_FIELD_KEYS = {"lat_rad": "motion.lat", "lon_rad": "motion.lon", "height_m": "motion.height",
+               "vel_n_mps": "initial_errors.velocity", "euler_b_rad": "motion",
+               "coarse_ticks": "firmware.coarse_time", "coarse_ratio": "firmware.coarse_ratio",
+               "coarse_first_output_ticks": "firmware.coarse_first_output",
+               "coarse_output_every_ticks": "firmware.coarse_output_every",
+               "coarse_method": "firmware.coarse_method", "fine_states": "firmware.fine_states",
+               "fine_gyro_arw": "firmware.fine_gyro_arw", "fine_accel_vrw": "firmware.fine_accel_vrw",
+               "fine_sigma0_att_rad": "firmware.fine_sigma0_att"}
+
+
 def _firmware_check(motion, cfg):
     """The firmware's own check (pyins_config_check) of the configuration a
     run of ``motion`` with the overrides ``cfg`` hands it."""
-    status = native.lib.pyins_config_check(native.make_config(initial_config(motion, None, **cfg)))
+    full = initial_config(motion, None, **cfg)
+    status = native.lib.pyins_config_check(native.make_config(full))
     if status != 0:
         name = native.status_str(status).split(":")[0]
-        raise ScenarioError(f"the firmware refuses the configuration: {native.status_str(status)}",
+        raise ScenarioError(f"the firmware refuses the configuration: {native.status_str(status)} "
+                            f"({limits.explain(status, full, _FIELD_KEYS)})",
                             _STATUS_KEYS.get(name, "firmware"))
 
 

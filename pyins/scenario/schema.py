@@ -13,6 +13,7 @@ figure metrics of `pyins.metrics`.
 from dataclasses import dataclass
 
 from pyins import metrics, sim
+from pyins.reference import abi
 from pyins.sim import turntable
 
 SCHEMA_VERSION = 1
@@ -224,16 +225,16 @@ STEP_KEYS = {
                     "-3600 deg", "3600 deg", required=True),
 }
 
-_VERTICAL_MODES = {"hold": 0, "free": 1}
-_FINE_CORRECTIONS = {"feedback": 0, "open_loop": 1}
-#: coarse_method name -> pyins_coarse_method
-_COARSE_METHODS = {"triad": 0, "fit": 1}
+#: the firmware's enums by the names scenario files and the CLI use
+VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
+FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
+COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT}
 FIRMWARE_KEYS = {
     "initial_attitude": Key("choice", "attitude the firmware starts from: the true one (plus "
                                       "[initial_errors]) or all Euler angles zero", "truth",
                             choices=("truth", "zero")),
     "vertical_mode": Key("choice", "vertical channel (firmware default hold)",
-                         choices=tuple(_VERTICAL_MODES)),
+                         choices=tuple(VERTICAL_MODES)),
     "coarse_time": _time("coarse alignment length (0: none)", None),
     "coarse_ratio": Key("dimensionless", "coarse alignment ratio r = t_k1 / t_k2 (firmware "
                                          "default 0.5)", lo=0, hi=1, lo_open=True, hi_open=True),
@@ -243,7 +244,7 @@ FIRMWARE_KEYS = {
                                  lo="0.01 s"),
     "coarse_method": Key("choice", "coarse alignment: 'triad' (seed 000, a base that does not move) "
                                    "or 'fit' (moving base: heave, surge, sway; firmware default "
-                                   "triad)", choices=tuple(_COARSE_METHODS)),
+                                   "triad)", choices=tuple(COARSE_METHODS)),
     "lever": Key("choice", "lever arms the firmware is told: 'configured' (the simulated "
                            "motion.lever_b and lever_p) or 'unknown' (zero)", "configured",
                  choices=("configured", "unknown")),
@@ -253,7 +254,7 @@ FIRMWARE_KEYS = {
     "fine_meas_every": _time("fine-alignment measurement interval (firmware default 0.1 s)", None,
                              lo="0.01 s", hi="1 h"),
     "fine_correction": Key("choice", "fine alignment feedback or open loop (firmware default "
-                                     "feedback)", choices=tuple(_FINE_CORRECTIONS)),
+                                     "feedback)", choices=tuple(FINE_CORRECTIONS)),
     "fine_gyro_arw": Key("angle_random_walk", "filter Q: gyro ARW (firmware default "
                                               "0.001 deg/sqrt(h))", lo="0 deg/sqrt(h)",
                          hi="10 deg/sqrt(h)", lo_open=True),
