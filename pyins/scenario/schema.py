@@ -249,8 +249,9 @@ FIRMWARE_KEYS = {
                            "motion.lever_b and lever_p) or 'unknown' (zero)", "configured",
                  choices=("configured", "unknown")),
     "fine_time": _time("fine alignment length (0: none)", None),
-    "fine_states": Key("int", "fine-alignment filter states, 5 or 8 (firmware default 5)", lo=5, hi=8,
-                       choices=(5, 8)),
+    "fine_states": Key("int", "fine-alignment filter states: 5 or 8 on a static base, 12 on a moored "
+                       "ship (position matched against the site; firmware default 5)", lo=5, hi=12,
+                       choices=(5, 8, 12)),
     "fine_meas_every": _time("fine-alignment measurement interval (firmware default 0.1 s)", None,
                              lo="0.01 s", hi="1 h"),
     "fine_correction": Key("choice", "fine alignment feedback or open loop (firmware default "

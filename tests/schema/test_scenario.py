@@ -32,6 +32,55 @@ def _tool(name):
     return module
 
 
+# Seed 002 as the paper sets it up (Table 1 initial errors, the schemes, the constant-rate turns),
+# written out here to check the built-ins seed002_exp* that tools/papers/reproduce_seed002.py runs.
+SEED002_PAPER = {1: (8.57, 3.70, 2.97), 2: (16.13, 12.90, 1.98)}
+SEED002_SCHEMES = ((0, "no rotation"), (2, "traditional two-position"), (4, "flexible two-position"),
+                   (6, "flexible, derivation form"))
+SEED002_PAPER_ACCEL = 600.0 * DEG        # 6 deg/s within one tick: the paper's constant-rate turns
+SEED002_PLANT_ACCEL = 1000.0 * DEG       # a motor that can follow SEED002_PAPER_ACCEL
+
+
+#: Seed 003's bounds (its Figs. 4-9), as tools/papers/reproduce_seed003.py prints them.
+SEED003_PAPER = {"position_nmi": 1.1, "level_arcmin": 0.01, "heading_arcmin": 0.3, "velocity_mps": 0.06}
+
+
+# Seed 001's static fine alignment (docs/papers.md, seed 001 §3; latitude ours).
+SEED001_LAT = 34.246 * DEG
+SEED001_EULER = np.array([-5.0, 2.0, 235.0]) * DEG
+SEED001_PHI0 = np.array([10.0, 10.0, 60.0]) * units.ARCMIN_TO_RAD
+SEED001_N = 1200 * units.TICK_HZ                 #: 1200 s of fine alignment [ticks]
+
+
+# Seed 000's coarse alignment (docs/papers.md, seed 000 §2): its bias levels with the noise of
+# seeds 002/003 (the same class of IMU), the static base at Xi'an and Table 2's swings.
+SEED000_LAT, SEED000_LON = 34.246 * DEG, 108.910 * DEG
+
+
+def seed000_errors():
+    e = sim.preset("error_free")
+    e.gyro_arw = sim.preset("seed002").gyro_arw       # 0.0005 deg/sqrt(h)
+    e.accel_vrw = sim.preset("seed002").accel_vrw     # 5 ug/sqrt(Hz)
+    e.gyro_bias = np.full(3, 0.01 * units.DPH_TO_RPS)
+    e.accel_bias = np.full(3, 100.0 * units.UG_TO_MPS2)
+    return e
+
+
+def seed000_motion(state, heading):
+    yaw = -heading * DEG
+    if state == "static":
+        return sim.Static(SEED000_LAT, SEED000_LON, 0.0, 0.5 * DEG, -0.3 * DEG, yaw)
+    return sim.sea_state(state, SEED000_LAT, SEED000_LON, 0.0, yaw0=yaw)
+
+
+def seed002_initial_errors(m):
+    """Seed 002 Table 1 errors on the true initial state of ``m``: pitch -10", roll 10",
+    heading +1' (yaw -1'), velocity 0.01 m/s east and north, position 10 m north and east."""
+    return scenario.initial_errors(m, pitch=-10.0 * units.ARCSEC_TO_RAD, roll=10.0 * units.ARCSEC_TO_RAD,
+                                   yaw=-60.0 * units.ARCSEC_TO_RAD, velocity=[0.01, 0.01, 0.0],
+                                   north=10.0, east=10.0)
+
+
 def assert_same_motion(a, b):
     """Same profile: the same class and bit-identical states at a few times."""
     assert type(a) is type(b)
@@ -86,26 +135,28 @@ def test_builtin_loads_resolves_and_gives_runs(name):
 
 def test_seed002_builtins_match_reproduce_seed002():
     tool = _tool("reproduce_seed002")
+    assert tool.PAPER == SEED002_PAPER and tool.VIDS[:4] == tuple(str(s) for s, _ in SEED002_SCHEMES)
     for exp in (1, 2):
         sc = scenario.load(f"seed002_exp{exp}")
         runs = list(sc.runs())
         m = sim.HeadingSwing.experiment(exp)
-        assert [r.config["index_scheme"] for r in runs] == [s for s, _ in tool.SCHEMES]
-        assert [r.label for r in runs] == [label for _, label in tool.SCHEMES]
+        assert [r.config["index_scheme"] for r in runs] == [s for s, _ in SEED002_SCHEMES]
+        assert [r.label for r in runs] == [label for _, label in SEED002_SCHEMES]
         for r in runs:
             assert_same_motion(r.motion, m)
             assert_same_errors(r.errors, sim.preset("seed002"))
-            want = dict(index_scheme=r.config["index_scheme"], index_accel_rad_s2=tool.PAPER_ACCEL)
-            want.update(tool.initial_errors(m))
-            assert r.table.accel_max_rad_s2 == tool.PLANT_ACCEL
+            want = dict(index_scheme=r.config["index_scheme"], index_accel_rad_s2=SEED002_PAPER_ACCEL)
+            want.update(seed002_initial_errors(m))
+            assert r.table.accel_max_rad_s2 == SEED002_PLANT_ACCEL
             assert_same_config(r.config, want)
             assert r.seed == 1 and r.duration_ticks == int(72.0 * 360_000)
         paper = [f["value_si"] / units.NMI_TO_M for f in sc.paper["figures"]]
-        assert paper == pytest.approx(tool.PAPER[exp], rel=1e-12)
+        assert paper == pytest.approx(SEED002_PAPER[exp], rel=1e-12)
 
 
 def test_seed003_builtin_matches_reproduce_seed003():
     tool = _tool("reproduce_seed003")
+    assert tool.PAPER == SEED003_PAPER
     runs = list(scenario.load("seed003").runs())
     assert [r.config for r in runs] == [dict(index_scheme=0), dict(index_scheme=1)]
     for r in runs:
@@ -114,36 +165,41 @@ def test_seed003_builtin_matches_reproduce_seed003():
         assert r.seed == 1 and r.duration_ticks == int(24.0 * 360_000)
     figs = {f["metric"]: f for f in scenario.load("seed003").paper["figures"]}
     assert figs["horizontal_error_max"]["value_si"] == pytest.approx(
-        tool.PAPER["position_nmi"] * units.NMI_TO_M)
+        SEED003_PAPER["position_nmi"] * units.NMI_TO_M)
     assert figs["level_error_max"]["value_si"] == pytest.approx(
-        tool.PAPER["level_arcmin"] * units.ARCMIN_TO_RAD)
+        SEED003_PAPER["level_arcmin"] * units.ARCMIN_TO_RAD)
     assert figs["velocity_error_max"]["relation"] == "<"
 
 
 @pytest.mark.parametrize("states", [5, 8])
 def test_seed001_builtins_match_reproduce_seed001(states):
     tool = _tool("reproduce_seed001")
+    assert tool.SCENARIOS[states] == f"seed001_fine{states}"
     (r,) = scenario.load(f"seed001_fine{states}").runs()
-    assert_same_motion(r.motion, sim.Static(tool.LAT, 108.91 * DEG, 0.0, *tool.EULER))
+    assert_same_motion(r.motion, sim.Static(SEED001_LAT, 108.91 * DEG, 0.0, *SEED001_EULER))
     assert_same_errors(r.errors, sim.preset("seed001"))
-    guess = attitude.mat_to_euler(attitude.rotvec_to_mat(-tool.PHI0) @ attitude.euler_to_mat(tool.EULER))
-    assert_same_config(r.config, dict(euler_b_rad=guess, fine_ticks=tool.N, fine_states=states))
-    assert r.seed == 0 and r.duration_ticks == tool.N
+    guess = attitude.mat_to_euler(attitude.rotvec_to_mat(-SEED001_PHI0)
+                                  @ attitude.euler_to_mat(SEED001_EULER))
+    assert_same_config(r.config, dict(euler_b_rad=guess, fine_ticks=SEED001_N, fine_states=states))
+    assert r.seed == 0 and r.duration_ticks == SEED001_N
 
 
 def test_seed000_builtins_match_reproduce_seed000():
     tool = _tool("reproduce_seed000")
+    assert tool.HEADINGS == (0, 60, 120, 180, 240, 300)
+    assert (tool.LAT, tool.LON) == (SEED000_LAT, SEED000_LON)
+    assert_same_errors(tool.sensors(seed=3)[1], seed000_errors())
     runs = list(scenario.load("seed000_static").runs())
     assert [r.seed for r in runs] == [1000 * 0 + s for s in range(5)]
     for r in runs:
-        assert_same_motion(r.motion, tool.motion("static", 0))
-        assert_same_errors(r.errors, tool.sensors(seed=r.seed)[1])
+        assert_same_motion(r.motion, seed000_motion("static", 0))
+        assert_same_errors(r.errors, seed000_errors())
         assert_same_config(r.config, dict(coarse_ticks=15_000, coarse_ratio=0.5,
                                           euler_b_rad=[0.0, 0.0, 0.0]))
     runs = list(scenario.load("seed000_swing").runs())
     for r, state in zip(runs, ("ideal", "general", "bad")):
-        assert_same_motion(r.motion, tool.motion(state, 0))
-        assert_same_errors(r.errors, tool.sensors(seed=7)[1])
+        assert_same_motion(r.motion, seed000_motion(state, 0))
+        assert_same_errors(r.errors, seed000_errors())
         assert_same_config(r.config, dict(coarse_ticks=20_000, coarse_ratio=0.5,
                                           euler_b_rad=[0.0, 0.0, 0.0]))
         assert r.seed == 7 + 1000 * 0 + 0
@@ -490,8 +546,10 @@ def test_smoke_builtin_run_equals_the_reproduce_tool_run():
     run = list(sc.runs())[2]
     assert run.label == "flexible two-position" and run.duration_ticks == 500 and run.every == 50
     ours = runs.run(run)
+    vid, tool_run = tool.variants(1, {"duration": "5 s", "record_every": "0.5 s"})[2]
+    assert vid == "4" and runs.run(tool_run).outputs.tobytes() == ours.outputs.tobytes()
     m = sim.HeadingSwing.experiment(1)
-    theirs = fil.run_fil(m, 500, config=dict(index_scheme=4, **tool.initial_errors(m)),
+    theirs = fil.run_fil(m, 500, config=dict(index_scheme=4, **seed002_initial_errors(m)),
                          errors=sim.preset("seed002"), seed=1, every=50)
     assert len(ours.outputs) == 10
     assert ours.outputs.tobytes() == theirs.outputs.tobytes()

@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
 """Compare the indexing schemes on the horizontal gyro drifts alone.
+The ships, the turntable and the error set are the built-in scenarios
+seed002_exp1/seed002_exp2 with overrides (and reproduce_seed002's
+"horizontal gyro drifts only"); this driver adds the table.
 
     .venv/bin/python tools/papers/compare_schemes.py [--hours 72] [--out runs/compare_schemes]
 
@@ -21,39 +24,44 @@ import json
 import os
 import sys
 
-import numpy as np
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reproduce_seed002 import ERROR_SETS, SCENARIOS  # noqa: E402
 
-from pyins import analysis, fil, metrics, progress, sim
-from pyins.sim import motion
-from pyins.sim.turntable import TableConfig
-from pyins.units import DEG_TO_RAD as DEG
-from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
+from pyins import analysis, metrics, runs, scenario  # noqa: E402
+from pyins import progress as progress_bars  # noqa: E402
+from pyins.units import NMI_TO_M, TICK_HZ  # noqa: E402
 
 #: (id, scheme, index_sums, label)
-VARIANTS = (("none", 0, 0, "no rotation"), ("two", 2, 0, "traditional"),
-            ("flex", 4, 0, "flexible, literal"), ("derived", 6, 0, "derivation form"),
-            ("derived_all", 6, 1, "derivation form, turns summed"),
-            ("flex_all", 4, 1, "literal, turns summed"))
+VARIANTS = (("none", "none", "stops", "no rotation"), ("two", "two_position", "stops", "traditional"),
+            ("flex", "flexible", "stops", "flexible, literal"),
+            ("derived", "flexible_derived", "stops", "derivation form"),
+            ("derived_all", "flexible_derived", "all", "derivation form, turns summed"),
+            ("flex_all", "flexible", "all", "literal, turns summed"))
 #: (id, label, accel [deg/s^2])
 SHIPS = (("exp1", "seed 002 exp. 1 (T = 120 s)", 30.0), ("exp1", "exp. 1, 600 deg/s^2", 600.0),
          ("exp2", "seed 002 exp. 2 (T = 60 s)", 30.0), ("exp2", "exp. 2, 600 deg/s^2", 600.0),
          ("static", "static ship, heading 15 deg", 30.0))
-PLANT_ACCEL = 1000.0 * DEG        # a motor that can follow 600 deg/s^2
+#: ship id -> (built-in scenario, overrides): seed 002's heading swings; its site, attitude and
+#: heading without the swing
+SHIP_SCENARIOS = {"exp1": (SCENARIOS[1], {}), "exp2": (SCENARIOS[2], {}),
+                  "static": (SCENARIOS[1], {"motion.kind": "static", "motion.rate_amplitude": None,
+                                            "motion.period": None})}
+#: every run: one scheme, no [paper], the horizontal gyro drifts as the only error, noise seed 0
+COMMON = {"compare": None, "paper": None, "seed": 0, **ERROR_SETS["hdrift"]}
 
 
-def ship(name):
-    if name == "static":
-        return sim.Static(motion.SEED002_LAT, motion.SEED002_LON, motion.SEED002_HEIGHT,
-                          motion.SEED002_PITCH, motion.SEED002_ROLL, -15.0 * DEG)
-    return sim.HeadingSwing.experiment(int(name[-1]))
+def spec_of(name, scheme, sums, accel_deg, hours):
+    """The RunSpec of ship ``name`` with one scheme, its sums and turn acceleration [deg/s^2]."""
+    ticks = int(hours * (3600 * TICK_HZ))
+    base, overrides = SHIP_SCENARIOS[name]
+    (spec,) = scenario.load(base).with_overrides({
+        **COMMON, **overrides, "duration": f"{ticks / TICK_HZ!r} s", "indexing.scheme": scheme,
+        "indexing.sums": sums, "indexing.acceleration": f"{accel_deg:g} deg/s^2"}).runs()
+    return spec
 
 
-def run_one(m, scheme, sums, accel_deg, hours, progress):
-    drift = 0.003 * DPH_TO_RPS
-    errors = sim.SensorErrors(gyro_bias=np.array([drift, drift, 0.0]))
-    res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), errors=errors, every=TICK_HZ,
-                      config=dict(index_scheme=scheme, index_sums=sums, index_accel_rad_s2=accel_deg * DEG),
-                      table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress)
+def run_one(spec, progress):
+    res = runs.run(spec, progress=progress)
     e = metrics.nav_errors(res)
     return {"max_nmi": float(e.horizontal_m.max() / NMI_TO_M),
             "final_nmi": float(e.horizontal_m[-1] / NMI_TO_M),
@@ -68,20 +76,19 @@ def main(argv=None):
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    progress = None if args.quiet else progress.TextProgress()
+    progress = None if args.quiet else progress_bars.TextProgress()
     out = {"hours": args.hours, "gyro_drift_deg_h": 0.003}
     head = "| ship | " + " | ".join(v[3] for v in VARIANTS) + " |"
     rows = [f"Max horizontal error [nmi] over {args.hours:g} h, horizontal gyro drifts only "
             "(surviving fraction; flexible fallbacks if any)", "", head,
             "|" + "---|" * (len(VARIANTS) + 1)]
     for name, label, accel in SHIPS:
-        m = ship(name)
         cells = []
         for vid, scheme, sums, _ in VARIANTS:
-            if scheme == 0 and accel != 30.0:
+            if scheme == "none" and accel != 30.0:
                 cells.append("")       # no turns: the acceleration does not matter
                 continue
-            f = run_one(m, scheme, sums, accel, args.hours, progress)
+            f = run_one(spec_of(name, scheme, sums, accel, args.hours), progress)
             key = f"{name}_accel{accel:g}_{vid}"
             out[f"{key}_max_horizontal_nmi"] = f["max_nmi"]
             out[f"{key}_final_horizontal_nmi"] = f["final_nmi"]

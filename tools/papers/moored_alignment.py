@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
 """Alignment on a moored ship: heave, surge, sway and a lever arm.
+The ship and sensors are the built-in scenarios moored_ideal/general/bad, the
+headings and noise seeds those of the campaign seed000_swing; this driver
+adds the alignments compared, the limits and the table.
 
     .venv/bin/python tools/papers/moored_alignment.py [--out runs/moored] [--seeds 10]
 
@@ -10,9 +13,8 @@ deg/sqrt(h) and VRW 5 ug/sqrt(Hz) borrowed from seeds 002/003, the same
 class of IMU) and N noise seeds, the heading and level errors against the
 truth and against the theoretical limit at 200, 300 and 600 s, for:
 
-- ``swing``: seed 000's swing about the IMU, as the paper simulates it (with
-  the 2 m lever arm of the moored ship, configured: pure rotation about the
-  reference point);
+- ``swing``: seed 000's swing about the IMU, as the paper simulates it (no
+  linear motion, no lever arm: pure rotation about the reference point);
 - ``moored``: the same swing plus the moored ship's linear motion (heave
   0.5 m at 8 s, surge 0.3 m at 12 s, sway 0.3 m at 10 s) and the 2 m lever
   arm (0.5, 1.5, 1.2) m (`pyins.sim.moored`), the lever arm configured;
@@ -31,45 +33,88 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from reproduce_seed000 import HEADINGS, LAT, LON, limit_euler, sensors  # noqa: E402
+from reproduce_seed000 import HEADINGS, SWING, limit_euler  # noqa: E402
 
-from pyins import native, scenario, sim  # noqa: E402
+from pyins import campaign, native, scenario, sim  # noqa: E402
 from pyins.units import ARCMIN_TO_RAD as ARCMIN  # noqa: E402
 from pyins.units import ARCSEC_TO_RAD as ARCSEC  # noqa: E402
-from pyins.units import DEG_TO_RAD as DEG  # noqa: E402
 from pyins.units import TICK_HZ, TWO_PI  # noqa: E402
-SEA_STATES = ("ideal", "general", "bad")
+
+#: sea state -> the built-in scenario of the moored ship (swing, heave, surge, sway, lever arm,
+#: seed 000's sensors); its headings and noise seeds are those of the campaign seed000_swing
+SCENARIOS = {"ideal": "moored_ideal", "general": "moored_general", "bad": "moored_bad"}
+SEA_STATES = tuple(campaign.load_campaign(SWING).grid["motion.sea_state"])
 TIMES_S = (200, 300, 600)
-#: The alignments compared: (label, firmware configuration). Durations in
-#: ticks; TRIAD's history holds 255 intervals, so its 300 s run is on a 2 s
-#: grid; FIT halves its grid when full and runs 600 s on 1 s outputs; the
-#: static Kalman filter of seed 001 (5 states) or the moving-base filter (12
-#: states, position matching) follows 120 s of FIT.
+#: the ships: seed 000's swing about the reference point alone (no linear motion, no lever arm),
+#: and the moored ship as the built-in has it
+SHIPS = {"swing": {"motion.heave": None, "motion.surge": None, "motion.sway": None,
+                   "motion.lever_b": ["0 m", "0 m", "0 m"]},
+         "moored": {}}
+#: ship -> its cases: (name, firmware.lever)
+CASES = {"swing": (("swing", "configured"),),
+         "moored": (("moored", "configured"), ("moored_unknown_lever", "unknown"))}
+#: The alignments compared: (label, (overrides of the scenario, firmware configuration the
+#: scenario cannot write: none today)). TRIAD's history holds 255 intervals, so its 300 s run is on a 2 s
+#: grid; FIT halves its grid when full and runs 600 s on 1 s outputs; the static Kalman filter
+#: of seed 001 (5 states) or the moving-base filter (12 states, position matching) follows
+#: 120 s of FIT.
+_FIT = {"firmware.coarse_method": "fit", "firmware.coarse_output_every": None}
+_FIT_FINE = {"firmware.coarse_time": "120 s", **_FIT, "firmware.fine_time": "480 s", "duration": "600 s"}
 ALIGNMENTS = {
-    "triad": dict(coarse_ticks=30000, coarse_method=0, coarse_output_every_ticks=200),
-    "fit": dict(coarse_ticks=60000, coarse_method=1),
-    "fit+kf5": dict(coarse_ticks=12000, coarse_method=1, fine_ticks=48000, fine_states=5),
-    "fit+mb12": dict(coarse_ticks=12000, coarse_method=1, fine_ticks=48000, fine_states=12),
+    "triad": ({"firmware.coarse_time": "300 s", "firmware.coarse_method": "triad",
+               "firmware.coarse_output_every": "2 s", "duration": "300 s"}, {}),
+    "fit": ({"firmware.coarse_time": "600 s", **_FIT, "duration": "600 s"}, {}),
+    "fit+kf5": ({**_FIT_FINE, "firmware.fine_states": 5}, {}),
+    "fit+mb12": ({**_FIT_FINE, "firmware.fine_states": 12}, {}),
 }
+#: scenario key -> the firmware configuration field it sets (moored.json lists them per alignment)
+_CONFIG_FIELDS = {"firmware.coarse_time": "coarse_ticks", "firmware.coarse_method": "coarse_method",
+                  "firmware.coarse_output_every": "coarse_output_every_ticks",
+                  "firmware.fine_time": "fine_ticks", "firmware.fine_states": "fine_states"}
 
 
-def motions(state, heading):
-    yaw = -heading * DEG
-    swing = sim.sea_state(state, LAT, LON, 0.0, yaw0=yaw)
-    return {"swing": sim.ShipAtSea(swing), "moored": sim.moored(state, LAT, LON, 0.0, yaw)}
+def points(state, n_seeds):
+    """heading [deg] -> [Scenario]: the moored ship of sea state ``state`` at that mean heading,
+    one per noise seed (seed000_swing's seed formula), without [compare] and [paper]."""
+    swing = campaign.load_campaign(SWING)
+    camp = campaign.from_args(SCENARIOS[state], {"motion.heading": [f"{h} deg" for h in HEADINGS]},
+                              seeds=n_seeds, seed_formula=swing.seed_formula, compare="drop")
+    out = {h: [] for h in HEADINGS}
+    for point in camp.points:
+        heading = int(point.values["motion.heading"].split()[0])
+        out[heading].append(camp.base.with_overrides(point.overrides))
+    return out
+
+
+def spec_of(scn, ship, lever, align):
+    """The RunSpec of one case and alignment, with the configuration ``scenario.initial_config``
+    hands the firmware."""
+    overrides, extra = ALIGNMENTS[align]
+    (spec,) = scn.with_overrides({**SHIPS[ship], "firmware.lever": lever, **overrides}).runs()
+    spec.config.update(extra)
+    return spec
+
+
+def alignment_fields(scn):
+    """The firmware configuration fields each alignment sets (for moored.json)."""
+    out = {}
+    for align, (overrides, extra) in ALIGNMENTS.items():
+        config = spec_of(scn, "moored", "configured", align).config
+        fields = [_CONFIG_FIELDS[k] for k, v in overrides.items() if k in _CONFIG_FIELDS and v is not None]
+        out[align] = {f: int(config[f]) for f in fields + list(extra)}
+    return out
 
 
 def wrap(a):
     return (a + np.pi) % TWO_PI - np.pi
 
 
-def run_case(m, exact, model, align, lever_known):
-    dtheta, dv = model.apply(*exact)
-    cfg = scenario.initial_config(m, None, euler_b_rad=[0.0, 0.0, 0.0], **align)
-    if not lever_known:
-        cfg["lever_b_m"] = np.zeros(3)
-        cfg["lever_p_m"] = np.zeros(3)
-    n = cfg["coarse_ticks"] + cfg.get("fine_ticks", 0)
+def run_case(spec, exact):
+    """One alignment of ``spec`` on the exact increments of its motion, open loop, its sensor
+    noise drawn from its seed; records every 10 s."""
+    dtheta, dv = sim.SensorModel(spec.errors, seed=spec.seed).apply(*exact)
+    cfg = scenario.initial_config(spec.motion, None, **spec.config)
+    n = spec.duration_ticks
     return native.Firmware(cfg).run(native.make_samples(dtheta[:n], dv[:n]), every=1000)
 
 
@@ -83,18 +128,17 @@ def main(argv=None):
     n = TIMES_S[-1] * TICK_HZ
     rows = []   # dicts, one per (state, heading, case, alignment, seed, time)
     for state in SEA_STATES:
-        for h in HEADINGS:
-            for name, m in motions(state, h).items():
-                exact = sim.exact_increments(m, n)[:2]
+        for h, scns in points(state, args.seeds).items():
+            for ship, cases in CASES.items():
+                m = spec_of(scns[0], ship, "configured", "fit").motion
+                exact = sim.exact_increments(m, n)[:2]     # the same for every seed, case and alignment
                 truth = {t: sim.truth_at(m, np.array([t * TICK_HZ])) for t in TIMES_S}
-                cases = [(name, True)] if name == "swing" else [(name, True), (name + "_unknown_lever", False)]
-                for s in range(args.seeds):
-                    _, errs = sensors(seed=7 + 1000 * h + s)
+                for s, scn in enumerate(scns):
+                    errs = spec_of(scn, ship, "configured", "fit").errors
                     lim = {t: limit_euler(m, errs, float(t)) * ARCSEC for t in TIMES_S}
-                    for case, known in cases:
-                        for aname, align in ALIGNMENTS.items():
-                            model, _ = sensors(seed=7 + 1000 * h + s)   # the same draw for every case
-                            rec = run_case(m, exact, model, align, known)
+                    for case, lever in cases:
+                        for aname in ALIGNMENTS:
+                            rec = run_case(spec_of(scn, ship, lever, aname), exact)
                             for t in TIMES_S:
                                 i = np.flatnonzero(rec["tick"] == t * TICK_HZ)
                                 if not len(i):
@@ -152,7 +196,8 @@ def main(argv=None):
               f"PYINS_FAULT_COARSE_UNSETTLED at that time. Runs with |heading err| > 10' still "
               f"flagged valid: {missed}.")
     out = {"seeds": args.seeds, "headings_deg": list(HEADINGS), "times_s": list(TIMES_S),
-           "alignments": {k: {kk: int(vv) for kk, vv in v.items()} for k, v in ALIGNMENTS.items()},
+           "alignments": alignment_fields(scenario.load(SCENARIOS[SEA_STATES[0]]).with_overrides(
+               {"compare": None, "paper": None})),
            "wrong_but_valid_runs": missed, "wall_s": time.time() - t0, "cases": summary}
     with open(os.path.join(args.out, "moored.json"), "w") as f:
         json.dump(out, f, indent=1)

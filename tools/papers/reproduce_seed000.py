@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
 """Reproduce seed 000 (inertial-frame coarse alignment) with the C++ firmware.
+The set-up is the built-in campaigns seed000_static and seed000_swing (their
+headings, seed formulas and base scenarios, pyins/campaigns/ and
+pyins/scenarios/); this driver adds the theoretical limits, tables and curves.
 
     .venv/bin/python tools/papers/reproduce_seed000.py [--out runs/seed000] [--seeds 5]
 
@@ -29,37 +32,75 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, metrics, runner, sim
+from pyins import analysis, campaign, metrics, runner, scenario, sim
 from pyins.reference.config import DEFAULT_COARSE_FIRST_S
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import ARCSEC_TO_RAD as ARCSEC
 from pyins.units import DEG_TO_RAD as DEG
-from pyins.units import DPH_TO_RPS, TICK_HZ, TWO_PI, UG_TO_MPS2
-LAT, LON = 34.246 * DEG, 108.910 * DEG
-HEADINGS = (0, 60, 120, 180, 240, 300)
+from pyins.units import TICK_HZ, TWO_PI, split_quantity
+
+#: the built-in campaigns (and their base scenarios) holding the set-up: Table 1's static
+#: alignments, the swinging base's, their headings and noise seeds
+STATIC, SWING = "seed000_static", "seed000_swing"
+_STATIC_BASE = scenario.load(STATIC).with_overrides({"compare": None, "paper": None})
+_SITE = next(_STATIC_BASE.runs()).motion
+LAT, LON = _SITE.lat, _SITE.lon
+HEADINGS = tuple(int(split_quantity(h)[0])
+                 for h in campaign.load_campaign(STATIC).grid["motion.heading"])
+#: the convergence curves (Figs. 1 and 2): 250 s at heading 0, one noise seed
+CURVES = {"duration": "250 s", "firmware.coarse_time": "250 s"}
+CURVES_HEADING, CURVES_SEED = 0, 5
 
 
-def sensors(gyro_dph=0.01, accel_ug=100.0, seed=0, noise=True):
-    e = sim.preset("error_free")
-    if noise:
-        e.gyro_arw = sim.preset("seed002").gyro_arw       # 0.0005 deg/sqrt(h)
-        e.accel_vrw = sim.preset("seed002").accel_vrw     # 5 ug/sqrt(Hz)
-    e.gyro_bias = np.full(3, gyro_dph * DPH_TO_RPS)
-    e.accel_bias = np.full(3, accel_ug * UG_TO_MPS2)
-    return sim.SensorModel(e, seed=seed), e
+def sensors(gyro_dph=None, accel_ug=None, seed=0, noise=True):
+    """(SensorModel drawing from ``seed``, SensorErrors): the sensors of seed000_static, its
+    drift [deg/h] and bias [ug] replaced when given, without noise when ``noise`` is False."""
+    overrides = {}
+    if gyro_dph is not None:
+        overrides["sensors.gyro_bias"] = f"{gyro_dph!r} deg/h"
+    if accel_ug is not None:
+        overrides["sensors.accel_bias"] = f"{accel_ug!r} ug"
+    if not noise:
+        overrides.update({"sensors.gyro_arw": 0, "sensors.accel_vrw": 0})
+    (spec,) = _STATIC_BASE.with_overrides(overrides).runs()
+    return sim.SensorModel(spec.errors, seed=seed), spec.errors
+
+
+def run_spec(state, heading, seed, overrides=None):
+    """The RunSpec of one alignment: seed000_static (``state`` "static") or seed000_swing at
+    sea state ``state``, at mean ``heading`` [deg] with noise ``seed``, and ``overrides``."""
+    o = {"compare": None, "paper": None, "motion.heading": f"{heading} deg", "seed": seed}
+    if state != "static":
+        o["motion.sea_state"] = state
+    (spec,) = scenario.load(STATIC if state == "static" else SWING).with_overrides(
+        {**o, **(overrides or {})}).runs()
+    return spec
 
 
 def motion(state, heading):
-    yaw = -heading * DEG
-    if state == "static":
-        return sim.Static(LAT, LON, 0.0, 0.5 * DEG, -0.3 * DEG, yaw)
-    return sim.sea_state(state, LAT, LON, 0.0, yaw0=yaw)
+    """The ship of `run_spec` (heading [deg])."""
+    return run_spec(state, heading, 0).motion
 
 
-def align(m, seconds, model, ratio=0.5):
-    n = int(seconds * TICK_HZ)
-    res = runner.navigate(m, n, every=TICK_HZ, sensors=model,
-                          config=dict(coarse_ticks=n, coarse_ratio=ratio, euler_b_rad=[0.0, 0.0, 0.0]))
+def campaign_specs(name, n_seeds):
+    """[(grid values, run, RunSpec)] of built-in campaign ``name`` with ``n_seeds`` noise
+    seeds per grid point (its seed formula), in its order (grid, then seeds)."""
+    camp = campaign.load_campaign(name)
+    camp = campaign.from_args(camp.base, camp.grid, seeds=n_seeds, group_by=camp.group_by,
+                              overrides=camp.overrides, seed_formula=camp.seed_formula,
+                              compare=camp.compare)
+    out = []
+    for point in camp.points:
+        (spec,) = camp.base.with_overrides(point.overrides).runs()
+        out.append((point.values, point.run, spec))
+    return out
+
+
+def navigate(spec):
+    """One alignment of ``spec``, open loop (pyins.runner.navigate, no turntable), its sensor
+    noise drawn from its seed."""
+    res = runner.navigate(spec.motion, spec.duration_ticks, every=spec.every,
+                          sensors=sim.SensorModel(spec.errors, seed=spec.seed), config=spec.config)
     return res, metrics.nav_errors(res)
 
 
@@ -88,14 +129,12 @@ def limit_euler(m, errors, t):
 
 def table_static(out, n_seeds, fig):
     rows = []
-    for h in HEADINGS:
-        m = motion("static", h)
-        for s in range(n_seeds):
-            model, errs = sensors(seed=1000 * h + s)
-            res, _ = align(m, 150, model)
-            err = euler_errors(res)
-            lim = limit_euler(m, errs, 150.0)
-            rows.append([h, s, *err, *(err - lim)])
+    for values, run, spec in campaign_specs(STATIC, n_seeds):
+        h = int(split_quantity(values["motion.heading"])[0])
+        res, _ = navigate(spec)
+        err = euler_errors(res)
+        lim = limit_euler(spec.motion, spec.errors, spec.duration_ticks / TICK_HZ)
+        rows.append([h, run, *err, *(err - lim)])
     a = np.array(rows)
     with open(os.path.join(out, "table1_static.csv"), "w") as f:
         f.write("heading_deg,seed,pitch_err_arcsec,roll_err_arcsec,heading_err_arcsec,"
@@ -127,15 +166,12 @@ def table_static(out, n_seeds, fig):
 
 def table_swing(out, n_seeds, fig):
     rows = []
-    for state in ("ideal", "general", "bad"):
-        for h in HEADINGS:
-            m = motion(state, h)
-            for s in range(n_seeds):
-                model, errs = sensors(seed=7 + 1000 * h + s)
-                res, _ = align(m, 200, model)
-                err = euler_errors(res)
-                lim = limit_euler(m, errs, 200.0)
-                rows.append([state, h, s, *err, *(err - lim)])
+    for values, run, spec in campaign_specs(SWING, n_seeds):
+        h = int(split_quantity(values["motion.heading"])[0])
+        res, _ = navigate(spec)
+        err = euler_errors(res)
+        lim = limit_euler(spec.motion, spec.errors, spec.duration_ticks / TICK_HZ)
+        rows.append([values["motion.sea_state"], h, run, *err, *(err - lim)])
     with open(os.path.join(out, "swing.csv"), "w") as f:
         f.write("sea_state,heading_deg,seed,pitch_err_arcsec,roll_err_arcsec,heading_err_arcsec,"
                 "pitch_vs_limit_arcsec,roll_vs_limit_arcsec,heading_vs_limit_arcsec\n")
@@ -143,7 +179,7 @@ def table_swing(out, n_seeds, fig):
             f.write(",".join([r[0]] + [f"{v:.6g}" for v in r[1:]]) + "\n")
     md = ["| sea state | max \\|level err\\| (\") | max \\|heading err\\| (') | max \\|level vs limit\\| (\") | max \\|heading vs limit\\| (') |",
           "|---|---|---|---|---|"]
-    for state in ("ideal", "general", "bad"):
+    for state in campaign.load_campaign(SWING).grid["motion.sea_state"]:
         g = np.array([r[3:] for r in rows if r[0] == state], dtype=float)
         lv, hd = np.abs(g[:, 0:2]).max(), np.abs(g[:, 2]).max() / 60
         lvl, hdl = np.abs(g[:, 3:5]).max(), np.abs(g[:, 5]).max() / 60
@@ -162,21 +198,21 @@ def curves(out, fig):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    m = motion("static", 0)
-    seconds = 250
     panels = [
-        ("fig1_gyro_bias.png", "gyro bias", [dict(gyro_dph=b) for b in (0.01, 0.03, 0.05)],
-         [f"{b} deg/h" for b in (0.01, 0.03, 0.05)], [0.5] * 3),
-        ("fig1_accel_bias.png", "accelerometer bias", [dict(accel_ug=b) for b in (100.0, 300.0, 500.0)],
-         [f"{b / 1000:g} mg" for b in (100.0, 300.0, 500.0)], [0.5] * 3),
-        ("fig2_ratio.png", "ratio r = t_k1 / t_k2", [dict()] * 3, ["r = 1/4", "r = 1/2", "r = 3/4"],
-         [0.25, 0.5, 0.75]),
+        ("fig1_gyro_bias.png", "gyro bias",
+         [(f"{b} deg/h", {"sensors.gyro_bias": f"{b} deg/h"}) for b in (0.01, 0.03, 0.05)]),
+        ("fig1_accel_bias.png", "accelerometer bias",
+         [(f"{b / 1000:g} mg", {"sensors.accel_bias": f"{b} ug"}) for b in (100.0, 300.0, 500.0)]),
+        ("fig2_ratio.png", "ratio r = t_k1 / t_k2",
+         [(label, {"firmware.coarse_ratio": r}) for label, r in (("r = 1/4", 0.25), ("r = 1/2", 0.5),
+                                                                  ("r = 3/4", 0.75))]),
     ]
-    for name, title, kws, labels, ratios in panels:
+    for name, title, curves_of in panels:
         fg, ax = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
-        for kw, label, r in zip(kws, labels, ratios):
-            model, errs = sensors(seed=5, **kw)
-            res, e = align(m, seconds, model, ratio=r)
+        for label, overrides in curves_of:
+            spec = run_spec("static", CURVES_HEADING, CURVES_SEED, {**CURVES, **overrides})
+            m, errs = spec.motion, spec.errors
+            res, e = navigate(spec)
             # every record after the first coarse output holds a solution; they
             # are all provisional (ATT_VALID unset) while the coarse phase runs
             ok = e.time_s > DEFAULT_COARSE_FIRST_S

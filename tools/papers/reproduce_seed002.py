@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
 """Reproduce seed 002 (flexible two-position scheme under heading motion, 72 h).
+The set-up is the built-in scenarios seed002_exp1 and seed002_exp2
+(pyins/scenarios/); the error sets, the turn accelerations and the turns
+summed are overrides of them. This driver adds the analysis and the report.
 
     .venv/bin/python tools/papers/reproduce_seed002.py [--out runs/seed002] [--hours 72]
 
@@ -32,60 +35,51 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, metrics, progress, scenario, sim
-from pyins.sim.turntable import TableConfig
-from pyins.units import ARCSEC_TO_RAD as ARCSEC
+from pyins import analysis, metrics, progress, runs, scenario
+from pyins.reference.config import DEFAULT_INDEX_ACCEL
 from pyins.units import DEG_TO_RAD as DEG
-from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
+from pyins.units import NMI_TO_M, TICK_HZ
 
-PAPER = {1: (8.57, 3.70, 2.97), 2: (16.13, 12.90, 1.98)}
-SCHEMES = ((0, "no rotation"), (2, "traditional two-position"), (4, "flexible two-position"),
-           (6, "flexible, derivation form"))        # the variants of the built-in seed002_exp* scenarios
-# (variant id, scheme, index_sums, label): SCHEMES with seed 002's sums, and our extension
-VARIANTS = tuple((str(s), s, 0, label) for s, label in SCHEMES) + (
-    ("6all", 6, 1, "flexible, derivation form, turns summed"),)
-VIDS = tuple(v[0] for v in VARIANTS)
-PAPER_ACCEL = 600.0 * DEG        # 6 deg/s within one tick: the paper's constant-rate turns
-DEFAULT_ACCEL = 30.0 * DEG       # the firmware default
-PLANT_ACCEL = 1000.0 * DEG       # a motor that can follow PAPER_ACCEL
-
-
-def initial_errors(m):
-    """Seed 002 Table 1 errors applied to the true initial state of ``m``
-    (`pyins.scenario.initial_errors`): pitch -10", roll 10", heading +1'
-    (yaw -1'), velocity 0.01 m/s east and north, position 10 m north and east."""
-    return scenario.initial_errors(m, pitch=-10.0 * ARCSEC, roll=10.0 * ARCSEC, yaw=-60.0 * ARCSEC,
-                                   velocity=[0.01, 0.01, 0.0], north=10.0, east=10.0)
-
-
-def error_sets():
-    """The error sets run, name -> (SensorErrors, with Table 1 initial errors)."""
-    t2 = sim.preset("seed002")
-    drift = 0.003 * DPH_TO_RPS
-    return {
-        "table2": (t2, True),
-        "hdrift": (sim.SensorErrors(gyro_bias=np.array([drift, drift, 0.0])), False),
-        "updrift": (sim.SensorErrors(gyro_bias=np.array([0.0, 0.0, drift])), False),
-        "sf_mis": (sim.SensorErrors(gyro_scale=t2.gyro_scale, gyro_misalignment=t2.gyro_misalignment,
-                                    accel_scale=t2.accel_scale,
-                                    accel_misalignment=t2.accel_misalignment), False),
-    }
-
-
+#: experiment -> the built-in scenario holding its set-up (motion, Table 1 and 2 errors, the
+#: four schemes, the turns, the paper's figures)
+SCENARIOS = {1: "seed002_exp1", 2: "seed002_exp2"}
+#: the paper's figures (nmi), in the order of its schemes: none, traditional, flexible
+PAPER = {exp: tuple(f["value"] for f in scenario.load(name).paper["figures"])
+         for exp, name in SCENARIOS.items()}
+#: our extension, beside the built-in's four schemes: the derivation form with the turns summed
+TURNS_SUMMED = ("6all", "flexible, derivation form, turns summed",
+                {"compare": None, "paper": None, "indexing.scheme": "flexible_derived",
+                 "indexing.sums": "all"})
+#: the error sets run: name -> overrides of the built-in (Table 2 with Table 1 initial errors as is)
+_DRIFT = "0.003 deg/h"
+ERROR_SETS = {
+    "table2": {},
+    "hdrift": {"sensors": {"gyro_bias": [_DRIFT, _DRIFT, 0]}, "initial_errors": None},
+    "updrift": {"sensors": {"gyro_bias": [0, 0, _DRIFT]}, "initial_errors": None},
+    "sf_mis": {"sensors": {"preset": "seed002", "gyro_bias": 0, "gyro_arw": 0, "accel_bias": 0,
+                           "accel_vrw": 0}, "initial_errors": None},
+}
 SET_LABEL = {"table2": "Table 2 (all), Table 1 initial errors", "hdrift": "horizontal gyro drifts only",
              "updrift": "up-gyro drift only", "sf_mis": "scale-factor and installation errors only"}
+#: the turn accelerations: the built-in's (the paper's constant-rate turns), the firmware default
+ACCELS = {"paper": {}, "default": {"indexing.acceleration": None}}
 
 
-def run_one(exp, scheme, sums, errors, with_init, accel, hours, seed):
-    m = sim.HeadingSwing.experiment(exp)
-    cfg = dict(index_scheme=scheme, index_accel_rad_s2=accel)
-    if sums:
-        cfg["index_sums"] = sums
-    if with_init:
-        cfg.update(initial_errors(m))
-    res = fil.run_fil(m, int(hours * (3600 * TICK_HZ)), config=cfg, errors=errors, seed=seed,
-                      every=TICK_HZ,
-                      table=TableConfig(accel_max_rad_s2=PLANT_ACCEL), progress=progress.TextProgress())
+def variants(exp, overrides):
+    """[(variant id, RunSpec)]: the built-in's schemes and TURNS_SUMMED, with ``overrides``."""
+    sc = scenario.load(SCENARIOS[exp])
+    out = [(str(spec.config["index_scheme"]), spec) for spec in sc.with_overrides(overrides).runs()]
+    vid, label, extra = TURNS_SUMMED
+    (spec,) = sc.with_overrides({**overrides, **extra}).runs()
+    spec.label = label
+    return out + [(vid, spec)]
+
+
+VIDS = tuple(vid for vid, _ in variants(1, {}))
+
+
+def run_one(spec):
+    res = runs.run(spec, progress=progress.TextProgress())
     e = metrics.nav_errors(res)
     psi = res.outputs["yaw_p_rad"]
     # the proxy of docs/papers.md, seed 002 §10 (from the 1 Hz records), split into the stopped
@@ -242,23 +236,26 @@ def main(argv=None):
 
     plan = [("table2", "paper"), ("hdrift", "paper"), ("hdrift", "default"), ("updrift", "paper"),
             ("sf_mis", "paper")]
-    accels = {"paper": PAPER_ACCEL, "default": DEFAULT_ACCEL}
-    sets = error_sets()
-    results, out = {}, {"hours": args.hours, "paper_accel_deg_s2": PAPER_ACCEL / DEG,
-                        "default_accel_deg_s2": DEFAULT_ACCEL / DEG}
+    ticks = int(args.hours * (3600 * TICK_HZ))
+    common = {"duration": f"{ticks / TICK_HZ!r} s", "seed": args.seed}
+    paper_accel = next(scenario.load(SCENARIOS[1]).runs()).config["index_accel_rad_s2"]
+    accels = {"paper": paper_accel, "default": DEFAULT_INDEX_ACCEL}
+    results, out = {}, {"hours": args.hours, "paper_accel_deg_s2": paper_accel / DEG,
+                        "default_accel_deg_s2": DEFAULT_INDEX_ACCEL / DEG}
     md = ["| experiment | errors | turn acceleration | scheme | final (nmi) | max (nmi) | paper (nmi) "
           "| drift surviving | of it: stops | turns |", "|---|---|---|---|---|---|---|---|---|---|"]
     fg, ax = plt.subplots(2, 2, figsize=(12, 8), sharex=True)
     for col, exp in enumerate((1, 2)):
+        paper_of = dict(zip((spec.label for spec in scenario.load(SCENARIOS[exp]).runs()), PAPER[exp]))
         for es, acc in plan:
-            errors, with_init = sets[es]
-            for vid, scheme, sums, label in VARIANTS:
-                f, e = run_one(exp, scheme, sums, errors, with_init, accels[acc], args.hours, args.seed)
+            for vid, spec in variants(exp, {**common, **ERROR_SETS[es], **ACCELS[acc]}):
+                label = spec.label
+                f, e = run_one(spec)
                 results[(exp, es, vid, acc)] = f
                 key = f"exp{exp}_{es}_{acc}accel_scheme{vid}"
                 for k, v in f.items():
                     out[f"{key}_{k}"] = v
-                paper = PAPER[exp][[0, 2, 4].index(scheme)] if es == "table2" and scheme != 6 else ""
+                paper = paper_of.get(label, "") if es == "table2" else ""
                 md.append(f"| {exp} | {SET_LABEL[es]} | {accels[acc] / DEG:g} deg/s^2 | {label} | "
                           f"{f['final_nmi']:.3f} | {f['max_nmi']:.3f} | {paper} | {f['survives']:.4f} | "
                           f"{f['survives_stops']:.4f} | {f['survives_turns']:.4f} |")

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Reproduce seed 003 (single-position forward/reverse rotate-stop, 24 h).
+The set-up (motion, sensor errors, the two schemes, the paper's bounds) is
+the built-in scenario seed003 (pyins/scenarios/seed003.toml); this driver
+adds the error theory, the figures and the explanation.
 
-    .venv/bin/python tools/papers/reproduce_seed003.py [--out runs/seed003]
+    .venv/bin/python tools/papers/reproduce_seed003.py [--out runs/seed003] [--hours 24] [--seed 1]
 
 Static ship, 24 h, seed 003's sensor errors (docs/papers.md, seed 003 §3:
 drift 0.003 deg/h, ARW 0.0005 deg/sqrt(h), gyro SF 0.466 ppm, accelerometer bias 20 ug and
@@ -22,12 +25,29 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, fil, metrics, progress, sim
+from pyins import analysis, metrics, progress, runs, scenario
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
 from pyins.units import NMI_TO_M, TICK_HZ
 
-PAPER = {"position_nmi": 1.1, "level_arcmin": 0.01, "heading_arcmin": 0.3, "velocity_mps": 0.06}
+#: The built-in scenario holding the set-up: motion, sensors, the two schemes, the paper's bounds.
+SCENARIO = "seed003"
+#: The same runs with the constant drifts and biases only: what error theory covers.
+BIASES_ONLY = {f"sensors.{k}": 0 for k in ("gyro_scale", "gyro_misalignment", "gyro_arw", "gyro_quantum",
+                                           "accel_scale", "accel_misalignment", "accel_vrw",
+                                           "accel_quantum")}
+#: our figure -> the scenario's [paper] metric
+FIGURES = {"position_nmi": "horizontal_error_max", "level_arcmin": "level_error_max",
+           "heading_arcmin": "heading_error_max", "velocity_mps": "velocity_error_max"}
+
+
+def paper_bounds(sc):
+    """The paper's bounds, in the units the scenario writes them in."""
+    figs = {f["metric"]: f["value"] for f in sc.paper["figures"]}
+    return {k: figs[metric] for k, metric in FIGURES.items()}
+
+
+PAPER = paper_bounds(scenario.load(SCENARIO))
 
 
 def figures(err):
@@ -38,6 +58,13 @@ def figures(err):
         "heading_arcmin": np.abs(err.att_n_rad[:, 2]).max() / ARCMIN,
         "velocity_mps": np.abs(err.vel_n_mps[:, :2]).max(),
     }
+
+
+def load(hours, seed):
+    """The built-in scenario for ``hours`` of ship time (ticks as int(hours * 3600 * TICK_HZ))
+    and noise ``seed``."""
+    ticks = int(hours * (3600 * TICK_HZ))
+    return scenario.load(SCENARIO).with_overrides({"duration": f"{ticks / TICK_HZ!r} s", "seed": seed})
 
 
 def main(argv=None):
@@ -51,19 +78,18 @@ def main(argv=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    lat = 34.246 * DEG
-    m = sim.Static(lat, 108.91 * DEG, 0.0)
-    errors = sim.preset("seed003")
-    ticks = int(args.hours * (3600 * TICK_HZ))
+    sc = load(args.hours, args.seed)
+    specs = list(sc.runs())
+    lat = specs[0].motion.lat
     grid = np.arange(1, int(args.hours * 12) + 1) * 300.0       # the linear model every 5 min
-    fig_json = {"hours": args.hours, "latitude_deg": 34.246}
+    fig_json = {"hours": args.hours, "latitude_deg": lat / DEG}
     rows = []
     fg, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
     zero3 = np.zeros(3)
-    up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
-    for scheme, label in ((0, "no rotation"), (1, "single-position fwd/rev (seed 003)")):
-        res = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), errors=errors, seed=args.seed,
-                          every=TICK_HZ, progress=progress.TextProgress())
+    for spec, spec_b in zip(specs, sc.with_overrides(BIASES_ONLY).runs()):
+        label, errors = spec.label, spec.errors
+        up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
+        res = runs.run(spec, progress=progress.TextProgress())
         e = metrics.nav_errors(res)
         # error theory with the same constant drifts and biases, and split by source
         theory = {
@@ -73,14 +99,12 @@ def main(argv=None):
             "accelerometer biases only": analysis.predict_static_fil(res, lat, zero3, zero3,
                                                                      errors.accel_bias, grid),
         }
-        tag = "rot" if scheme else "norot"
+        tag = "rot" if spec.config["index_scheme"] else "norot"
         rows.append((f"ours, {label}", figures(e)))
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_max_{k}"] = float(v)
         # the same run with the constant drifts and biases only: what theory covers
-        res_b = fil.run_fil(m, ticks, config=dict(index_scheme=scheme), seed=args.seed, every=TICK_HZ,
-                            errors=sim.SensorErrors(gyro_bias=errors.gyro_bias,
-                                                    accel_bias=errors.accel_bias))
+        res_b = runs.run(spec_b)
         rows.append((f"ours, {label}, constant drifts and biases only", figures(metrics.nav_errors(res_b))))
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_biases_only_max_{k}"] = float(v)
@@ -101,7 +125,7 @@ def main(argv=None):
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
     ax[3].set_xlabel("time [h]")
-    fg.suptitle(f"seed 003: static ship at {34.246} N, {args.hours:g} h, its sensor errors")
+    fg.suptitle(f"seed 003: static ship at {lat / DEG:g} N, {args.hours:g} h, its sensor errors")
     fg.tight_layout()
     fg.savefig(os.path.join(args.out, "errors.png"), dpi=100)
 
