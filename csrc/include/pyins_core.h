@@ -222,7 +222,9 @@ typedef struct pyins_config {
     double fine_gyro_arw;         /* Q: gyro angle random walk [rad/sqrt(s)]; 0 = 0.001 deg/sqrt(h) */
     double fine_accel_vrw;        /* R: accelerometer velocity random walk [(m/s)/sqrt(s)]; 0 = 10 ug/sqrt(Hz) */
     double fine_sigma0_att_rad[3]; /* initial sigma of phi E, N, U [rad]; 0 = 100', 100', 600'
-                                      (moving base, fine_states 12: 1', 1', 10') */
+                                      without a coarse phase; after one (coarse_ticks > 0) the fit
+                                      to its result: 3 x the expected error and wander, 1' to the
+                                      above (docs/core.md); moving base (fine_states 12): 1', 1', 10' */
     double fine_sigma0_gyro;      /* initial sigma of the gyro drifts [rad/s]; 0 = 0.01 deg/h */
     double fine_sigma0_accel;     /* initial sigma of the accelerometer biases [m/s^2]; 0 = 100 ug */
     /* Indexing (rotation modulation), active in NAVIGATE. For preset schemes

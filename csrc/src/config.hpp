@@ -34,6 +34,8 @@ inline constexpr double kDefaultFineArw = 0.001 * kDegToRad / 60.0;  ///< 0.001 
 inline constexpr double kDefaultFineVrw = 10.0e-6 * kG0;   ///< 10 ug/sqrt(Hz)
 inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminToRad, 100.0 * kArcminToRad,
                                                    600.0 * kArcminToRad};  ///< 10 x [10', 10', 60']
+// (without a coarse phase; after one the static filters fit the attitude
+// sigmas to the coarse result, capped at these: fine_align::sigma0_after_coarse)
 /// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
 /// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
 /// tools/papers/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of

@@ -2,6 +2,7 @@
 #include "fine_align.hpp"
 
 #include "earth.hpp"
+#include "math_portable.hpp"
 
 namespace pyins::fine_align {
 
@@ -26,6 +27,35 @@ kalman::Mat<N, N> system_matrix(double sin_lat, double cos_lat) {
         f(2, 4) = -1.0;   // eps_U^
     }
     return f;
+}
+
+void sigma0_after_coarse(Params& prm, double coarse_s, double wander, const double cap[3]) {
+    const double w_n = earth::kOmegaIe * prm.cos_lat;
+    // seed 001 §2: phi_E = -nabla_N / g, phi_N = nabla_E / g
+    const double lev_b = prm.sigma0_accel / prm.gravity;
+    const double lev_n = prm.accel_vrw / prm.gravity;
+    const double level2 = lev_b * lev_b + lev_n * lev_n / coarse_s;
+    // seed 001 §2: phi_U = -eps_E / w_N + tan L nabla_E / g
+    const double hd_b = prm.sigma0_gyro / w_n;
+    const double hd_l = prm.sin_lat / prm.cos_lat * lev_b;
+    const double hd_n = prm.gyro_arw / w_n;
+    const double head2 = hd_b * hd_b + hd_l * hd_l + hd_n * hd_n / coarse_s;
+    const double w2 = wander * wander;
+    const double fit[3] = {kAfterCoarseMargin * pmath::sqrt(level2 + w2),
+                           kAfterCoarseMargin * pmath::sqrt(level2 + w2),
+                           kAfterCoarseMargin * pmath::sqrt(head2 + w2)};
+    for (int i = 0; i < 3; ++i) {
+        if (prm.sigma0_att[i] == 0.0) {
+            double v = fit[i];
+            if (!(v >= kAfterCoarseFloor)) {  // also a NaN
+                v = kAfterCoarseFloor;
+            }
+            if (v > cap[i]) {
+                v = cap[i];
+            }
+            prm.sigma0_att[i] = v;
+        }
+    }
 }
 
 template <int N>

@@ -19,6 +19,12 @@
 // (seed 001 prints R as a copy of Q: a typo; the accelerometer noise
 // projected into n is meant). P0 = diag(sigma0)^2 with seed 001's
 // sigma0 = 10 x [10', 10', 60', 0.001 deg/h, 0.001 deg/h] by default.
+// After a coarse alignment an attitude sigma left 0 fits the coarse result
+// instead (sigma0_after_coarse; docs/core.md, "Fine alignment after a
+// coarse one"): seed 001's 600' of heading let the first updates swing the
+// heading by 5.7-9.5 deg on a quiet simulated site and by 162 deg on the
+// real PSINS laser-gyro log (measured), although the coarse heading was
+// right to a few arc-minutes.
 // Integrity: the normalised innovation squared of each update (chi-square,
 // 2 degrees of freedom, mean 2 while the model holds) is averaged over
 // windows of nis_window updates; a window mean beyond nis_max says the
@@ -40,6 +46,7 @@
 
 #include "kalman.hpp"
 #include "types.hpp"
+#include "units.hpp"
 
 namespace pyins::fine_align {
 
@@ -84,6 +91,21 @@ struct FineAlign {
 /// Continuous-time F of eq. 10 / eq. 23 for this filter.
 template <int N>
 kalman::Mat<N, N> system_matrix(double sin_lat, double cos_lat);
+
+/// The initial attitude sigma after a coarse alignment: margin x the
+/// coarse phase's expected error, never below the floor nor above the cap.
+inline constexpr double kAfterCoarseMargin = 3.0;
+inline constexpr double kAfterCoarseFloor = 1.0 * kArcminToRad;   ///< [rad]
+
+/// Replace each sigma0_att[i] that is 0 by the fit to a coarse alignment of
+/// coarse_s seconds whose solution wandered by `wander` (sine) over its last
+/// fifth, from the errors prm states (seed 001 §2's limits; docs/papers.md):
+///   level^2   = (sigma0_accel / g)^2 + accel_vrw^2 / (g^2 T)
+///   heading^2 = (sigma0_gyro / w_N)^2 + (tan L sigma0_accel / g)^2
+///               + gyro_arw^2 / (w_N^2 T),   w_N = Omega_ie cos L
+///   sigma0_att = min(cap, max(floor, margin sqrt(term^2 + wander^2)))
+/// (the white-noise terms: the sensor noise averaged over the T seconds).
+void sigma0_after_coarse(Params& prm, double coarse_s, double wander, const double cap[3]);
 
 template <int N>
 void init(FineAlign<N>& f, const Params& prm);

@@ -32,6 +32,17 @@ void count(uint32_t* counter, uint32_t n) {
 void Firmware::init(const pyins_config& raw) {
     const pyins_config cfg = config::config_resolved(raw);
     cfg_ = cfg;
+    // After a coarse alignment the static filter's attitude sigmas left 0
+    // stay 0 here: start_fine fits them to the coarse result
+    // (fine_align::sigma0_after_coarse). The moving-base filter keeps its
+    // default, already FIT's result with margin (config.hpp).
+    if (cfg.coarse_ticks > 0 && cfg.fine_states != 12) {
+        for (int i = 0; i < 3; ++i) {
+            if (raw.fine_sigma0_att_rad[i] == 0.0) {
+                cfg_.fine_sigma0_att_rad[i] = 0.0;
+            }
+        }
+    }
     dt_ = 1.0 / static_cast<double>(cfg.tick_hz);
     mode_ = Mode::kIdle;
     att_valid_ = cfg.coarse_ticks == 0;
@@ -297,6 +308,12 @@ void Firmware::start_fine() {
     prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
     prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
+    if (cfg_.coarse_ticks > 0) {
+        // capped at the default (copied: the inline table's address is not taken)
+        const double cap[3] = {config::kDefaultFineSigmaAtt[0], config::kDefaultFineSigmaAtt[1],
+                               config::kDefaultFineSigmaAtt[2]};
+        fine_align::sigma0_after_coarse(prm, static_cast<double>(cfg_.coarse_ticks) * dt_, coarse_.wander, cap);
+    }
     prm.nis_window = cfg_.integrity_nis_window > 0 ? cfg_.integrity_nis_window : 0;
     prm.nis_max = cfg_.integrity_nis_max;
     kf_states_ = cfg_.fine_states;

@@ -3,9 +3,12 @@
 Mirrors ``csrc/src/fine_align.{hpp,cpp}``; the header gives the model, the
 state layouts, the typo corrections and the defaults.
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from pyins.units import ARCMIN_TO_RAD
 
 from . import earth, kalman
 
@@ -75,6 +78,36 @@ def system_matrix(n, sin_lat, cos_lat):
         f[1, 3] = -1.0
         f[2, 4] = -1.0
     return f
+
+
+#: kAfterCoarseMargin, kAfterCoarseFloor [rad]
+AFTER_COARSE_MARGIN = 3.0
+AFTER_COARSE_FLOOR = 1.0 * ARCMIN_TO_RAD
+
+
+def sigma0_after_coarse(prm, coarse_s, wander, cap):
+    """Replace each prm.sigma0_att[i] that is 0 by the fit to a coarse
+    alignment of coarse_s seconds that wandered by ``wander`` (sine); seed
+    001 sec. 2's limits (csrc/src/fine_align.hpp gives the formula)."""
+    w_n = earth.OMEGA_IE * prm.cos_lat
+    lev_b = prm.sigma0_accel / prm.gravity      # seed 001 sec. 2: phi_E = -nabla_N / g, phi_N = nabla_E / g
+    lev_n = prm.accel_vrw / prm.gravity
+    level2 = lev_b * lev_b + lev_n * lev_n / coarse_s
+    hd_b = prm.sigma0_gyro / w_n                # seed 001 sec. 2: phi_U = -eps_E / w_N + tan L nabla_E / g
+    hd_l = prm.sin_lat / prm.cos_lat * lev_b
+    hd_n = prm.gyro_arw / w_n
+    head2 = hd_b * hd_b + hd_l * hd_l + hd_n * hd_n / coarse_s
+    w2 = wander * wander
+    fit = (AFTER_COARSE_MARGIN * math.sqrt(level2 + w2), AFTER_COARSE_MARGIN * math.sqrt(level2 + w2),
+           AFTER_COARSE_MARGIN * math.sqrt(head2 + w2))
+    for i in range(3):
+        if prm.sigma0_att[i] == 0.0:
+            v = fit[i]
+            if not v >= AFTER_COARSE_FLOOR:     # also a NaN
+                v = AFTER_COARSE_FLOOR
+            if v > cap[i]:
+                v = cap[i]
+            prm.sigma0_att[i] = v
 
 
 def init(n, prm):

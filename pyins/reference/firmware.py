@@ -61,6 +61,11 @@ class Firmware:
 
     def init(self, raw):
         cfg = config.config_resolved(raw)
+        # after a coarse alignment the static filter's attitude sigmas left 0
+        # stay 0: start_fine fits them to the coarse result
+        if cfg["coarse_ticks"] > 0 and cfg["fine_states"] != 12:
+            cfg["fine_sigma0_att_rad"] = np.array([0.0 if raw["fine_sigma0_att_rad"][i] == 0.0 else
+                                                   cfg["fine_sigma0_att_rad"][i] for i in range(3)])
         self.cfg = cfg
         self.dt = 1.0 / float(cfg["tick_hz"])
         self.mode = abi.PYINS_MODE_IDLE
@@ -253,6 +258,9 @@ class Firmware:
             accel_vrw=cfg["fine_accel_vrw"], sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
             nis_window=max(cfg["integrity_nis_window"], 0), nis_max=cfg["integrity_nis_max"])
+        if cfg["coarse_ticks"] > 0:
+            fine_align.sigma0_after_coarse(prm, float(cfg["coarse_ticks"]) * self.dt, self.coarse.wander,
+                                           config.DEFAULT_FINE_SIGMA_ATT)
         self.kf_states = cfg["fine_states"]
         self.fine_tick = 0
         if self.kf_states == 12:
