@@ -25,10 +25,10 @@ import time
 
 import numpy as np
 
-from pyins import (__version__, bench, campaign, engine, limits, logs, metrics, native, report, runner, runs,
-                   scenario, sim, units)
+from pyins import (__version__, bench, campaign, engine, logs, metrics, native, replay, replay_options, report,
+                   runner, runs, scenario, sim)
 from pyins.progress import TextProgress
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DT, NMI_TO_M, TICK_HZ, ScenarioError
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, TICK_HZ
 
 _TICKS_PER_HOUR = 3600 * TICK_HZ
 
@@ -168,10 +168,13 @@ def cmd_run(args):
     _say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
     try:
         summary = runs.execute(scn, out, progress=_progress(args), resume=args.resume,
-                               log=None if args.quiet or args.json else print, engine=args.engine)
+                               log=None if args.quiet or args.json else print, engine=args.engine,
+                               force=getattr(args, "force", False),
+                               notice=lambda text: print(f"pyins run: note: {text}", file=sys.stderr))
     except KeyboardInterrupt:
-        report.render(out)
-        print(f"pyins: interrupted; the partial result is in {out} (resume with --resume)", file=sys.stderr)
+        # no metrics or plots now (they can take longer than the user waits): the report reads the records
+        print(f"\npyins run: interrupted; the partial result is in {out}: `pyins report {out}` renders "
+              f"it, `pyins run ... --out {out} --resume` continues it", file=sys.stderr)
         return EXIT_INTERRUPTED
     path = report.render(out)
     for line in _summary_lines(summary):
@@ -224,58 +227,21 @@ def cmd_simulate(args):
     return EXIT_OK
 
 
-#: How the replay command names the firmware fields it sets (`pyins.limits`).
-_REPLAY_NAMES = {"tick_hz": "--rate", "lat_rad": "--lat", "lon_rad": "--lon", "height_m": "--height",
-                 "euler_b_rad": "--attitude", "coarse_ticks": "--coarse",
-                 "coarse_output_every_ticks": "--coarse-every", "coarse_method": "--coarse-method",
-                 "fine_ticks": "--fine", "fine_states": "--fine-states",
-                 "fine_gyro_arw": "--gyro-arw", "fine_accel_vrw": "--accel-vrw",
-                 "fine_sigma0_att_rad": "--fine-sigma0"}
-
-
-def _replay_rate(args, data, spec):
-    """The log's sample rate [Hz] as the firmware's whole-number tick rate:
-    from the log (its time column, its dt, or --dt), else --rate, else the
-    scenario's; any two that disagree by more than 1 % are an error."""
-    rate, where = None, None
-    if data.dt:
-        rate, where = 1.0 / data.dt, ("--dt" if args.dt is not None else f"the log ({args.log})")
-    if args.rate is not None:
-        if not args.rate > 0:
-            raise InputError(f"--rate: {args.rate:g} Hz must be positive")
-        if rate is not None and abs(args.rate - rate) > 0.01 * rate:
-            raise InputError(f"--rate {args.rate:g} Hz disagrees with {where}: {rate:.6g} Hz")
-        rate, where = float(args.rate), "--rate"
-    if spec is not None:
-        scn_rate = 1.0 / spec.dt
-        if rate is not None and abs(scn_rate - rate) > 0.01 * rate:
-            raise InputError(f"{where} gives {rate:.6g} Hz, the scenario {spec.scenario!r} runs at "
-                             f"{scn_rate:g} Hz: its truth would not fit the log")
-        if rate is None:
-            rate, where = scn_rate, f"the scenario {spec.scenario!r}"
-    if rate is None:
-        raise InputError(f"{args.log}: no sample rate: the log has no time column or dt; give --rate HZ")
-    hz = int(round(rate))
-    # 1 ns: the reader rounds an inferred tick to it
-    if hz < 1 or abs(1.0 / hz - 1.0 / rate) > 1e-9 + 1e-6 / rate:
-        raise InputError(f"{where}: {rate:.9g} Hz is not a whole number of Hz; the firmware steps at an "
-                         "integer tick rate (resample the log)")
-    return hz
-
-
-def _quantity(option, text, dimension):
-    try:
-        return units.parse_quantity(text, dimension)
-    except ScenarioError as exc:
-        raise InputError(f"{option} {text!r}: {exc.reason}") from None
-
-
 def cmd_replay(args):
     read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
-                   axes=args.axes, time_col=args.time_col)
+                   axes=args.axes, time_col=args.time_col, gyro_scale=args.gyro_scale,
+                   accel_scale=args.accel_scale)
     if args.table_angle is not None:
         read_kw["table_angle"] = np.radians(args.table_angle)
-    data = logs.read_log(args.log, args.format, **{k: v for k, v in read_kw.items() if v is not None})
+    if args.columns is not None:
+        read_kw["columns"] = logs.parse_columns(args.columns, "--columns")
+    data = logs.read_log(args.log, args.format, strict=not args.allow_gaps,
+                         strict_hint="--allow-gaps replays it, bridging the gaps",
+                         **{k: v for k, v in read_kw.items() if v is not None})
+    if args.allow_gaps:     # the gaps and the bridge, said (metadata["warnings"])
+        data, _ = logs.bridge_gaps(data, how="--allow-gaps")
+        for w in data.metadata["warnings"]:
+            print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     scn = None
     if args.scenario:
         scn = scenario.load(args.scenario)
@@ -286,57 +252,20 @@ def cmd_replay(args):
     if scn is not None:
         specs = list(scn.runs())
         spec = specs[int(data.metadata.get("variant", 0)) if not args.scenario else 0]
-        cfg = runs.replay_config(spec)
+        cfg = replay.replay_config(spec)
 
-    # 1. the rate, the initial state and the firmware options, each as the user gave it
-    hz = _replay_rate(args, data, spec)
-    cfg["tick_hz"] = hz
-    for name, val in (("lat_rad", args.lat), ("lon_rad", args.lon)):
-        if val is not None:
-            cfg[name] = np.radians(val)
-    if args.height is not None:
-        cfg["height_m"] = args.height
-    if args.attitude is not None:
-        cfg["euler_b_rad"] = np.radians(args.attitude)
-    for option, field, val in (("--coarse", "coarse_ticks", args.coarse),
-                               ("--fine", "fine_ticks", args.fine),
-                               ("--coarse-every", "coarse_output_every_ticks", args.coarse_every)):
-        if val is not None:
-            if not (val >= 0 and np.isfinite(val)):
-                raise InputError(f"{option}: {val:g} s must be a time of zero or more seconds")
-            cfg[field] = int(round(val * hz))
-    if args.coarse_method is not None:
-        cfg["coarse_method"] = scenario.COARSE_METHODS[args.coarse_method]
-    if args.fine_states is not None:
-        cfg["fine_states"] = args.fine_states
-    if args.fine_correction is not None:
-        cfg["fine_correction"] = scenario.FINE_CORRECTIONS[args.fine_correction]
-    if args.vertical is not None:
-        cfg["vertical_mode"] = args.vertical
-    if args.fine_sigma0 is not None:
-        cfg["fine_sigma0_att_rad"] = [_quantity("--fine-sigma0", t, "angle") for t in args.fine_sigma0]
-    if args.gyro_arw is not None:
-        cfg["fine_gyro_arw"] = _quantity("--gyro-arw", args.gyro_arw, "angle_random_walk")
-    if args.accel_vrw is not None:
-        cfg["fine_accel_vrw"] = _quantity("--accel-vrw", args.accel_vrw, "velocity_random_walk")
-
+    # 1. the rate, the initial state and the firmware options, each as the user gave it;
     # 2. what the firmware cannot be right without, refused before it runs
-    if "lat_rad" not in cfg:
-        raise InputError(f"{args.log}: no initial position: give --scenario or --lat/--lon/--height "
-                         "(and --attitude, or --coarse to align)")
-    if "euler_b_rad" not in cfg and cfg.get("coarse_ticks", 0) <= 0:
-        raise InputError(f"{args.log}: no initial attitude: give --attitude PITCH ROLL YAW [deg], or "
-                         "--coarse SECONDS to align on the log (without either the firmware would start "
-                         "level and facing north)")
-    refused = limits.check(cfg, _REPLAY_NAMES)
-    if refused is not None:
-        raise InputError(refused[1])
+    cfg, hz = replay_options.config(args, data, spec, cfg, say=lambda text: _say(args, text))
 
     # 3. the log through the firmware
     out_dir = args.out or _default_out("replay")
     every = args.every if args.every is not None else hz
-    summary = runs.replay(data, cfg, out_dir, every=every, spec=spec, engine=args.engine,
-                          log_path=args.log)
+    if args.reference is not None and spec is not None:
+        raise InputError("--reference: the log's scenario is its reference already (drop --reference)")
+    summary = replay.replay(data, cfg, out_dir, every=every, spec=spec, engine=args.engine,
+                            log_path=args.log, reference=args.reference)
+    page = report.render(out_dir)
     _say(args, f"pyins replay {args.log}: {summary['samples']} samples at {hz} Hz "
                f"-> {out_dir}/navigation.npz")
     if "aligned" in summary:
@@ -350,18 +279,31 @@ def cmd_replay(args):
         print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     if "errors" in summary:
         er = summary["errors"]
-        _say(args, f"  against the scenario's truth: max horizontal {er['horizontal_max_m']:.2f} m, "
-                   f"final heading {er['heading_final_arcmin']:.3f}'")
+        extra = (f", final heading {er['heading_final_arcmin']:.3f}'" if "heading_final_arcmin" in er
+                 else f", max speed {er['speed_max_mps']:.3f} m/s")
+        _say(args, f"  against {er['reference']}: max horizontal {er['horizontal_max_m']:.2f} m{extra}")
+    _say(args, f"  report: {page}")
     _emit_json(args, summary)
     return EXIT_OK
 
 
 def cmd_report(args):
-    if not os.path.exists(os.path.join(args.rundir, "summary.json")):
-        raise InputError(f"{args.rundir}: not a run directory (no summary.json)")
-    path = report.render(args.rundir)
-    _say(args, f"report: {path}")
-    _emit_json(args, dict(report=path))
+    if report.is_replay_dir(args.rundir):      # pyins replay's directory: its own page
+        path = report.render(args.rundir)
+        _say(args, f"report: {path}")
+        _emit_json(args, dict(report=path, complete=True))
+        return EXIT_OK
+    if runs.read_summary(args.rundir) is None:
+        what = ("the run stopped before it wrote its summary" if os.path.exists(
+            os.path.join(args.rundir, "resolved_scenario.json")) else "not a run directory")
+        raise InputError(f"{args.rundir}: {what} (no readable summary.json)")
+    summary, series = report.run.load(args.rundir)
+    path = report.render(args.rundir, loaded=(summary, series))
+    partial = not summary.get("complete")
+    _say(args, f"report: {path}" + (f"  [PARTIAL, {summary.get('stopped', 'interrupted')}: the figures "
+                                    "cover the ticks done]" if partial else ""))
+    _emit_json(args, dict(report=path, complete=not partial, stopped=summary.get("stopped"),
+                          variants=summary["variants"]))
     return EXIT_OK
 
 
@@ -414,10 +356,14 @@ def cmd_campaign(args):
             print(f"\r  {done}/{total} runs ({skipped} already done)", end="", file=sys.stderr, flush=True)
     try:
         result = campaign.run_campaign(camp, out, workers=args.workers, scheduler=args.scheduler,
-                                       progress=progress)
-    except KeyboardInterrupt:
-        print(f"\npyins: interrupted; finished runs are kept in {out}/runs (rerun the same command "
-              "to resume)", file=sys.stderr)
+                                       progress=progress,
+                                       notice=lambda text: print(f"pyins campaign: note: {text}",
+                                                                 file=sys.stderr))
+    except KeyboardInterrupt as exc:
+        ex = (getattr(exc, "result", None) or {}).get("execution", {})
+        done = f"{ex['computed'] + ex['skipped']} of {ex['runs']} runs finished, " if ex else ""
+        print(f"\npyins campaign: interrupted; {done}kept in {out}/runs; partial aggregates in "
+              f"{os.path.join(out, 'aggregate.md')} (rerun the same command to resume)", file=sys.stderr)
         return EXIT_INTERRUPTED
     if not args.quiet and not args.json and sys.stderr.isatty():
         print(file=sys.stderr)
@@ -468,6 +414,7 @@ def build_parser():
     p.add_argument("--seed", type=int, help="override the noise seed")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario key (repeatable)")
     p.add_argument("--resume", action="store_true", help="continue an interrupted run in --out")
+    p.add_argument("--force", action="store_true", help="replace a run of another scenario in --out")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
                    help="the firmware and plant: native (compiled, default) or reference (NumPy mirror)")
     p = cmd("simulate", "write the IMU log of a scenario (open loop, table fixed)")
@@ -477,12 +424,20 @@ def build_parser():
     p.add_argument("--hours", type=float)
     p.add_argument("--variant", type=int, default=0, help="which [compare] variant (default 0)")
     p = cmd("replay", "run a recorded IMU log through the firmware")
-    p.add_argument("log")
-    p.add_argument("--format")
+    p.add_argument("log", help="the IMU log: .txt/.dat/.asc, .csv, .bin, .npz, PSINS .imu; "
+                   "also gzip/xz/bzip2-compressed (docs/log-formats.md)")
+    p.add_argument("--format", choices=logs.FORMATS, help="default: from the extension")
     p.add_argument("--scenario", help="initial state and truth from this scenario")
     p.add_argument("--kind", choices=["increments", "rates"])
-    p.add_argument("--gyro-unit")
-    p.add_argument("--accel-unit")
+    p.add_argument("--gyro-unit", help="increments: rad, deg, arcsec; rates: rad/s, deg/s, deg/h, arcsec/s")
+    p.add_argument("--accel-unit", help="increments: m/s, mm/s, ug*s; rates: m/s^2, g, mg, ug")
+    p.add_argument("--gyro-scale", type=float, help="gyro unit per count, e.g. 0.1 with --gyro-unit arcsec")
+    p.add_argument("--accel-scale", type=float, help="accelerometer unit per count")
+    p.add_argument("--columns", metavar="ROLE=NAME,...",
+                   help="CSV header names for the roles t, gyro_x..z, accel_x..z, table, e.g. t=time,gyro_x=gx")
+    p.add_argument("--allow-gaps", action="store_true",
+                   help="replay a log with missing samples: each gap is bridged (the firmware's "
+                        "linear interpolation) and named in a WARNING line")
     p.add_argument("--axes", help="axis mapping, e.g. frd or frd->rfu (default rfu)")
     p.add_argument("--time-col", choices=["first", "last", "none"])
     p.add_argument("--dt", type=float, help="sample interval [s] when the log has no time")
@@ -508,6 +463,8 @@ def build_parser():
     p.add_argument("--accel-vrw", help="accelerometer noise the fine filter assumes, e.g. \"10 ug/sqrt(Hz)\"")
     p.add_argument("--vertical", choices=("hold", "free"), help="vertical channel (default hold)")
     p.add_argument("--every", type=int, help="record every N samples (default: one a second)")
+    p.add_argument("--reference", choices=replay.REFERENCES,
+                   help="errors against: parked = the site (--lat/--lon/--height) and zero velocity")
     p.add_argument("--out", help="output directory (default runs/replay)")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
                    help="the firmware: native (compiled, default) or reference (NumPy mirror)")

@@ -9,9 +9,18 @@ angle at ``t_k`` [rad]. docs/log-formats.md has the same content with examples.
 
 Formats (``fmt``; when None, taken from the extension)
 ------------------------------------------------------
-- ``"npz"`` (.npz) and ``"csv"`` (.csv): the project's files, read and written
-  by `pyins.sim.io`; they take no unit, axis or layout options. `read_log`
-  runs the magnitude checks on them too and reports skipped ticks as gaps.
+- ``"npz"`` (.npz): the project's file, read and written by `pyins.sim.io`;
+  no unit, axis or layout options. `read_log` runs the magnitude checks on it
+  too and reports skipped ticks as gaps.
+- ``"csv"`` (.csv): a header line names the columns, mapped to roles by name
+  (`CSV_ALIASES`, or ``columns=``); ``#``/``%`` comment lines; the text
+  options below apply. The project's own header (`pyins.sim.io.CSV_HEADER`
+  on line 1) is read by `pyins.sim.io` as before.
+- ``"psins"`` (.imu): PSINS's compact SIMU file (base/io/imufile.m): three
+  header lines (initial state; position, t0, ts [ms], g; scale factors in
+  arcsec and ug*s), then integer pulse counts, x right, y forward, z up.
+- Any of them gzip/xz/bzip2-compressed: the extension is looked through for
+  the format, the first bytes tell the compression (`compression_of`).
 - ``"text"`` (.txt, .dat, .asc): whitespace-separated numbers, one sample a
   line. Blank lines and lines whose first non-blank character is ``#`` or
   ``%`` are skipped. Columns, with ``g`` the gyro triad and ``a`` the
@@ -39,10 +48,12 @@ Formats (``fmt``; when None, taken from the extension)
 Units and kinds (text and binary)
 ---------------------------------
 ``kind="increments"`` (default): per-sample increments, ``gyro_unit`` "rad"
-(default) or "deg", ``accel_unit`` "m/s" (default).
-``kind="rates"``: angular rate, ``gyro_unit`` "rad/s" (default), "deg/s" or
-"deg/h", and specific force, ``accel_unit`` "m/s^2" (default) or "g"
-(standard gravity G0 = 9.80665 m/s^2). Rates become increments by the
+(default), "deg" or "arcsec", ``accel_unit`` "m/s" (default), "mm/s" or
+"ug*s".
+``kind="rates"``: angular rate, ``gyro_unit`` "rad/s" (default), "deg/s",
+"deg/h" or "arcsec/s", and specific force, ``accel_unit`` "m/s^2" (default),
+"g", "mg" or "ug" (standard gravity G0 = 9.80665 m/s^2). Pulse counts:
+``gyro_scale``/``accel_scale``, the unit of one count. Rates become increments by the
 rectangular rule: ``increment_k = rate_k * (t_k - t_{k-1})``, the rate at
 ``t_k`` held over the interval that ends there; the first sample, which has no
 previous time, uses the nominal dt. Table angle: ``table_unit`` "rad"
@@ -108,26 +119,35 @@ the ticks are 1..N. All reader errors are `LogError` (a ValueError) with a
 one-line message ``"<file>: <where>: <reason>"``; wrong options (unknown
 unit, bad axes matrix, ...) are plain ValueErrors.
 """
+import bz2
+import gzip
+import io as _io
+import lzma
 import os
 from dataclasses import dataclass
 
 import numpy as np
 
-from pyins.units import DEG_TO_RAD, DPH_TO_RPS, DT, G0
+from pyins.units import ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS, DT, G0, UG_TO_MPS2
 from pyins.sim import io
 from pyins.sim.io import ImuData
 
-FORMATS = ("npz", "csv", "text", "binary")
+FORMATS = ("npz", "csv", "text", "binary", "psins")
 EXTENSIONS = {".npz": "npz", ".csv": "csv", ".txt": "text", ".dat": "text", ".asc": "text",
-              ".bin": "binary"}
+              ".bin": "binary", ".imu": "psins"}
+#: compression: extension -> (name, magic bytes at the start of the file, opener)
+COMPRESSIONS = {".gz": ("gzip", b"\x1f\x8b", gzip.open), ".xz": ("xz", b"\xfd7zXZ\x00", lzma.open),
+                ".bz2": ("bzip2", b"BZh", bz2.open)}
 KINDS = ("increments", "rates")
 TIME_COLS = ("last", "first", "none")
 
 #: Unit -> factor to SI, per kind.
-GYRO_UNITS = {"increments": {"rad": 1.0, "deg": DEG_TO_RAD},
-              "rates": {"rad/s": 1.0, "deg/s": DEG_TO_RAD, "deg/h": DPH_TO_RPS}}
-ACCEL_UNITS = {"increments": {"m/s": 1.0},
-               "rates": {"m/s^2": 1.0, "g": G0}}
+GYRO_UNITS = {"increments": {"rad": 1.0, "deg": DEG_TO_RAD, "arcsec": ARCSEC_TO_RAD},
+              "rates": {"rad/s": 1.0, "deg/s": DEG_TO_RAD, "deg/h": DPH_TO_RPS,
+                        "arcsec/s": ARCSEC_TO_RAD}}
+#: "ug*s": a micro-g held for a second, 1e-6 G0 m/s (a pulse-count accelerometer's unit)
+ACCEL_UNITS = {"increments": {"m/s": 1.0, "mm/s": 1e-3, "ug*s": UG_TO_MPS2},
+               "rates": {"m/s^2": 1.0, "g": G0, "mg": 1e-3 * G0, "ug": UG_TO_MPS2}}
 TABLE_UNITS = {"rad": 1.0, "deg": DEG_TO_RAD}
 
 #: File axes -> p (right-forward-up): v_p = AXES[name] @ v_file.
@@ -164,17 +184,73 @@ class LogIssue:
 # ---------------------------------------------------------------------------
 # Options
 # ---------------------------------------------------------------------------
+def _split_compression(path):
+    """(path without a compression extension, the compression's name or None)."""
+    base, ext = os.path.splitext(os.fspath(path))
+    if ext.lower() in COMPRESSIONS:
+        return base, COMPRESSIONS[ext.lower()][0]
+    return os.fspath(path), None
+
+
 def format_of(path, fmt=None):
-    """The format of ``path``: ``fmt`` checked, or the one its extension names."""
+    """The format of ``path``: ``fmt`` checked, or the one its extension names
+    (a compression extension .gz/.xz/.bz2 is looked through: log.csv.gz is csv)."""
     if fmt is not None:
         if fmt not in FORMATS:
             raise ValueError(f"fmt {fmt!r} is not one of {FORMATS}")
         return fmt
-    ext = os.path.splitext(os.fspath(path))[1].lower()
+    ext = os.path.splitext(_split_compression(path)[0])[1].lower()
     if ext not in EXTENSIONS:
         raise ValueError(f"{os.fspath(path)}: cannot tell the format from the extension {ext!r} "
-                         f"(known: {', '.join(EXTENSIONS)}); pass fmt= one of {FORMATS}")
+                         f"(known: {', '.join(EXTENSIONS)}, each also with "
+                         f"{', '.join(COMPRESSIONS)}); pass fmt= one of {FORMATS}")
     return EXTENSIONS[ext]
+
+
+def compression_of(path):
+    """The compression of the file at ``path`` from its first bytes ("gzip", "xz",
+    "bzip2"), else None; the extension does not decide (a .gz that is plain
+    text is read as plain text)."""
+    with open(path, "rb") as f:
+        head = f.read(6)
+    for name, magic, _ in COMPRESSIONS.values():
+        if head.startswith(magic):
+            return name
+    return None
+
+
+def _opener(path):
+    comp = compression_of(path)
+    for name, _, opener in COMPRESSIONS.values():
+        if name == comp:
+            return comp, opener
+    return None, open
+
+
+def _read_bytes(path, name):
+    """The whole file, decompressed; a broken stream is a LogError."""
+    comp, opener = _opener(path)
+    try:
+        with opener(path, "rb") as f:
+            return f.read()
+    except (OSError, EOFError, lzma.LZMAError, ValueError) as exc:
+        if comp is None:
+            raise
+        raise LogError(f"{name}: not a complete {comp} stream ({exc}): the file is cut or "
+                       f"damaged") from None
+
+
+def _text_lines(path, name):
+    """(1-based line number, line) of a text file, decompressed, UTF-8."""
+    raw = _read_bytes(path, name)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        comp = compression_of(path)
+        what = f"after {comp} decompression, " if comp else ""
+        raise LogError(f"{name}: {what}byte offset {exc.start}: not UTF-8 text (a binary log? "
+                       f"pass fmt='binary')") from None
+    return enumerate(_io.StringIO(text.lstrip("\ufeff"), newline=None), start=1)
 
 
 def axes_matrix(axes):
@@ -231,12 +307,33 @@ class _Options:
     time_col: str
     table: object      # True, False or None (text: decided by the first data line)
     dt: float
+    gyro_scale: float = 1.0     # raw gyro numbers are multiplied by it, then by the unit
+    accel_scale: float = 1.0
+    columns: dict = None        # csv: role -> header name, the user's mapping
 
 
 def _options(path, fmt, *, dt, kind, gyro_unit, accel_unit, axes, time_col, table,
-             table_unit, writing):
+             table_unit, writing, gyro_scale=1.0, accel_scale=1.0, columns=None):
     fmt = format_of(path, fmt)
-    if fmt in ("npz", "csv"):
+    for label, scale in (("gyro_scale", gyro_scale), ("accel_scale", accel_scale)):
+        if not (isinstance(scale, (int, float)) and np.isfinite(scale) and scale > 0):
+            raise ValueError(f"{label} must be a positive number (the unit per count), "
+                             f"got {scale!r}")
+    if columns is not None and fmt not in ("csv", "npz"):
+        raise ValueError(f"columns= names CSV header columns or npz arrays; it does not apply "
+                         f"to {fmt}")
+    if fmt == "psins":
+        given = {"kind": (kind, ("increments",)), "gyro_unit": (gyro_unit, (None,)),
+                 "accel_unit": (accel_unit, (None,)), "time_col": (time_col, (None,)),
+                 "table": (table, (None, False)), "gyro_scale": (gyro_scale, (1.0,)),
+                 "accel_scale": (accel_scale, (1.0,))}
+        extra = [k for k, (value, allowed) in given.items() if value not in allowed]
+        if extra:
+            raise ValueError(f"psins: a PSINS .imu file states its units, scale factors and "
+                             f"time in its header; options {sorted(extra)} do not apply")
+        return _Options(fmt, "increments", "rad", "m/s", table_unit, axes_matrix(axes), axes,
+                        "first", False, None if dt is None else float(dt))
+    if writing and fmt in ("npz", "csv"):
         given = {"kind": (kind, ("increments",)), "gyro_unit": (gyro_unit, (None, "rad")),
                  "accel_unit": (accel_unit, (None, "m/s")), "time_col": (time_col, (None,)),
                  "table": (table, (None,)), "table_unit": (table_unit, ("rad",))}
@@ -277,8 +374,13 @@ def _options(path, fmt, *, dt, kind, gyro_unit, accel_unit, axes, time_col, tabl
             raise ValueError(f"dt must be a positive number of seconds, got {dt!r}")
     if fmt in ("text", "binary") and time_col == "none" and dt is None and not writing:
         raise ValueError("time_col='none': the file has no time column, pass dt")
+    if columns is not None:
+        roles = CSV_ROLES if fmt == "csv" else NPZ_ROLES
+        if not isinstance(columns, dict) or not set(columns) <= set(roles):
+            raise ValueError(f"columns must map roles {list(roles)} to "
+                             f"{'header' if fmt == 'csv' else 'array'} names, got {columns!r}")
     return _Options(fmt, kind, gyro_unit, accel_unit, table_unit, axes_matrix(axes), axes,
-                    time_col, table, dt)
+                    time_col, table, dt, float(gyro_scale), float(accel_scale), columns)
 
 
 def _columns(time_col, has_table):
@@ -347,35 +449,30 @@ def _parse_text(path, name, opt):
     ncol = None if opt.table is None else base + bool(opt.table)
     rows, numbers = [], []
     first_line = None
-    try:
-        with open(path, "r", encoding="utf-8", newline=None) as f:
-            for lineno, line in enumerate(f, start=1):
-                tokens = line.lstrip("\ufeff").split()
-                if not tokens or tokens[0][0] in "#%":
-                    continue
-                if ncol is None:
-                    if len(tokens) not in (base, base + 1):
-                        cols = " ".join(_columns(opt.time_col, False))
-                        raise LogError(f"{name}: line {lineno}: expected {base} or {base + 1} "
-                                       f"columns ({cols} [table]), got {len(tokens)}"
-                                       f"{_comma_hint(tokens)}")
-                    ncol = len(tokens)
-                    first_line = lineno
-                elif len(tokens) != ncol:
-                    cols = " ".join(_columns(opt.time_col, ncol > base))
-                    like = f", like line {first_line}" if first_line else ""
-                    raise LogError(f"{name}: line {lineno}: expected {ncol} columns ({cols})"
-                                   f"{like}, got {len(tokens)}{_comma_hint(tokens)}")
-                elif first_line is None:
-                    first_line = lineno
-                try:
-                    rows.append([float(tok) for tok in tokens])
-                except ValueError:
-                    _bad_token(name, lineno, tokens, _columns(opt.time_col, ncol > base))
-                numbers.append(lineno)
-    except UnicodeDecodeError as exc:
-        raise LogError(f"{name}: byte offset {exc.start}: not UTF-8 text (a binary log? "
-                       f"pass fmt='binary')") from None
+    for lineno, line in _text_lines(path, name):
+        tokens = line.split()
+        if not tokens or tokens[0][0] in "#%":
+            continue
+        if ncol is None:
+            if len(tokens) not in (base, base + 1):
+                cols = " ".join(_columns(opt.time_col, False))
+                raise LogError(f"{name}: line {lineno}: expected {base} or {base + 1} "
+                               f"columns ({cols} [table]), got {len(tokens)}"
+                               f"{_comma_hint(tokens)}")
+            ncol = len(tokens)
+            first_line = lineno
+        elif len(tokens) != ncol:
+            cols = " ".join(_columns(opt.time_col, ncol > base))
+            like = f", like line {first_line}" if first_line else ""
+            raise LogError(f"{name}: line {lineno}: expected {ncol} columns ({cols})"
+                           f"{like}, got {len(tokens)}{_comma_hint(tokens)}")
+        elif first_line is None:
+            first_line = lineno
+        try:
+            rows.append([float(tok) for tok in tokens])
+        except ValueError:
+            _bad_token(name, lineno, tokens, _columns(opt.time_col, ncol > base))
+        numbers.append(lineno)
     if not rows:
         raise LogError(f"{name}: no data lines (only blank or comment lines)")
     columns = _columns(opt.time_col, ncol > base)
@@ -397,14 +494,14 @@ def _plural(n, words):
 
 def _comma_hint(tokens):
     if any("," in tok or ";" in tok for tok in tokens):
-        return " (this reader splits on whitespace; the project's CSV is fmt='csv')"
+        return " (this reader splits on whitespace; a CSV with a header line is fmt='csv')"
     return ""
 
 
 def _parse_binary(path, name, opt):
     columns = _columns("first", opt.table)
     size = 8 * len(columns)
-    raw = open(path, "rb").read()
+    raw = _read_bytes(path, name)
     n, rest = divmod(len(raw), size)
     kind = "with the table angle" if opt.table else "without the table angle"
     if rest:
@@ -415,6 +512,294 @@ def _parse_binary(path, name, opt):
         raise LogError(f"{name}: no records (empty file)")
     values = np.frombuffer(raw, dtype="<f8").reshape(n, len(columns)).astype(float)
     return values, _Records(n, columns), bool(opt.table)
+
+
+def _csv_aliases():
+    """Header names each role answers to (lower case, a unit in brackets dropped)."""
+    out = {"t": ("t", "time", "timestamp", "time_s", "t_s", "sec", "seconds", "gps_time",
+                 "gpst", "sow"),
+           "tick": ("tick",),
+           "table": ("table", "alpha", "table_angle", "table_angle_rad", "encoder")}
+    for axis in "xyz":
+        out[f"gyro_{axis}"] = tuple(n.format(axis) for n in (
+            "dtheta_{}", "dtheta_{}_rad", "gyro_{}", "gyr_{}", "g{}", "g_{}", "w{}", "w_{}",
+            "wm_{}", "omega_{}", "dang_{}", "angle_inc_{}", "dtheta{}"))
+        out[f"accel_{axis}"] = tuple(n.format(axis) for n in (
+            "dv_{}", "dv_{}_mps", "accel_{}", "acc_{}", "a{}", "a_{}", "f{}", "f_{}", "vm_{}",
+            "dvel_{}", "vel_inc_{}", "dv{}"))
+    return out
+
+
+CSV_ALIASES = _csv_aliases()
+CSV_ROLES = tuple(CSV_ALIASES)
+
+
+def _csv_name(field):
+    """A header field compared by name: lower case, no spaces, no unit suffix
+    in brackets ("gyro_x [rad]" -> "gyro_x")."""
+    field = field.strip().strip('"').lower()
+    for opening in "[(":
+        if opening in field:
+            field = field[:field.index(opening)]
+    return field.strip().replace(" ", "_")
+
+
+def _parse_csv(path, name, opt):
+    """A CSV whose header line names the columns: (values, where, has_table)
+    in the text layout "first" (or "none" without a time column); (None,
+    text) for the project's own header, which pyins.sim.io reads."""
+    lines = list(_text_lines(path, name))
+    header_at = next((k for k, (_, line) in enumerate(lines)
+                      if line.strip() and line.lstrip()[0] not in "#%"), None)
+    if header_at is None:
+        raise LogError(f"{name}: no header line (only blank or comment lines)")
+    lineno, header = lines[header_at]
+    if lineno == 1 and header.strip() == io.CSV_HEADER:
+        raw = _read_bytes(path, name).decode("utf-8")
+        return None, raw
+    sep = next((c for c in ",;\t" if c in header), None)
+    fields = [_csv_name(f) for f in (header.split(sep) if sep else header.split())]
+    try:
+        [float(f) for f in fields]
+        numeric = True
+    except ValueError:
+        numeric = False
+    if numeric:
+        raise LogError(f"{name}: line {lineno}: expected a header line naming the columns "
+                       f"(t, dtheta_x, ..., dv_z), got numbers; for a headerless log use "
+                       f"fmt='text' (whitespace) or pass the names")
+    index = {}
+    for role in CSV_ROLES:
+        wanted = ((_csv_name(opt.columns[role]),) if opt.columns and role in opt.columns
+                  else CSV_ALIASES[role])
+        hits = [c for c, f in enumerate(fields) if f in wanted]
+        if len(hits) > 1:
+            raise LogError(f"{name}: line {lineno}: columns {hits[0] + 1} and {hits[1] + 1} both "
+                           f"answer to {role} ({fields[hits[0]]!r}, {fields[hits[1]]!r}); say "
+                           f"which with columns={{{role!r}: ...}}")
+        if hits:
+            index[role] = hits[0]
+        elif opt.columns and role in opt.columns:
+            raise LogError(f"{name}: line {lineno}: no column {opt.columns[role]!r} for {role} "
+                           f"(the header has {', '.join(fields)})")
+    missing = [r for r in CSV_ROLES[3:9] if r not in index]
+    if missing:
+        r = missing[0]
+        raise LogError(f"{name}: line {lineno}: the header names no column for {r} (expected "
+                       f"one of {', '.join(CSV_ALIASES[r][:6])}, ...; or map it with "
+                       f"columns={{{r!r}: NAME}}); it has {', '.join(fields)}")
+    has_table = "table" in index if opt.table is None else bool(opt.table)
+    if has_table and "table" not in index:
+        raise LogError(f"{name}: line {lineno}: table=True, but no table-angle column (expected "
+                       f"one of {', '.join(CSV_ALIASES['table'])})")
+    if "t" in index:
+        opt.time_col, time_role = "first", "t"
+    elif "tick" in index:
+        if opt.dt is None:
+            raise LogError(f"{name}: line {lineno}: a tick column and no time column: pass dt")
+        opt.time_col, time_role = "first", "tick"
+    else:
+        if opt.dt is None:
+            raise LogError(f"{name}: line {lineno}: no time column (expected one of "
+                           f"{', '.join(CSV_ALIASES['t'])}): pass dt")
+        opt.time_col, time_role = "none", None
+    columns = _columns(opt.time_col, has_table)
+    roles = [time_role if c == "t" else c for c in columns]
+    take = [index[r] for r in roles]
+    rows, numbers = [], []
+    for lineno, line in lines[header_at + 1:]:
+        if not line.strip() or line.lstrip()[0] in "#%":
+            continue
+        tokens = line.rstrip("\n").split(sep) if sep else line.split()
+        if len(tokens) != len(fields):
+            raise LogError(f"{name}: line {lineno}: expected {len(fields)} fields like the header "
+                           f"(line {lines[header_at][0]}), got {len(tokens)}")
+        try:
+            rows.append([float(tokens[c]) for c in take])
+        except ValueError:
+            for c, col in zip(take, columns):
+                try:
+                    float(tokens[c])
+                except ValueError:
+                    raise LogError(f"{name}: line {lineno}, column {c + 1} ({fields[c]}, read "
+                                   f"as {col}): {tokens[c].strip()!r} is not a number") from None
+        numbers.append(lineno)
+    if not rows:
+        raise LogError(f"{name}: no data lines after the header (line {lines[header_at][0]})")
+    values = np.array(rows, dtype=float)
+    if time_role == "tick":
+        values[:, 0] = values[:, 0] * opt.dt
+    return values, _Lines(np.array(numbers), columns), has_table
+
+
+#: npz arrays by role: a triad as one (N, 3) array or three (N,) arrays
+NPZ_ALIASES = {"t": ("t", "time", "timestamp", "time_s"), "tick": ("tick",),
+               "gyro": ("dtheta", "dtheta_p", "gyro", "gyr", "wm", "w", "omega", "dang"),
+               "accel": ("dv", "dv_p", "accel", "acc", "vm", "f", "dvel"),
+               "table": ("table", "alpha", "table_angle", "table_angle_rad")}
+for _axis in "xyz":
+    NPZ_ALIASES[f"gyro_{_axis}"] = CSV_ALIASES[f"gyro_{_axis}"]
+    NPZ_ALIASES[f"accel_{_axis}"] = CSV_ALIASES[f"accel_{_axis}"]
+NPZ_ROLES = tuple(NPZ_ALIASES)
+
+
+def _parse_npz(path, name, opt):
+    """An npz of other arrays than the project's, found by name (`NPZ_ALIASES`
+    or ``columns=``): (values, where, has_table) in the text layout "first"
+    (or "none"); None for the project's own file (its arrays, no mapping)."""
+    raw = _read_bytes(path, name)
+    try:
+        npz = np.load(_io.BytesIO(raw), allow_pickle=False)
+        files = list(npz.files)
+    except (OSError, ValueError) as exc:
+        raise LogError(f"{name}: not a readable .npz file ({exc})") from None
+    if opt.columns is None and all(k in files for k in io._NPZ_KEYS):
+        return None
+    lower = {f.lower(): f for f in files}
+
+    def find(role):
+        if opt.columns and role in opt.columns:
+            key = opt.columns[role]
+            if key not in files:
+                raise LogError(f"{name}: no array {key!r} for {role} (the file has "
+                               f"{', '.join(files)})")
+            return key
+        return next((lower[a] for a in NPZ_ALIASES[role] if a in lower), None)
+
+    def array(key, shape):
+        try:
+            a = np.asarray(npz[key], dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise LogError(f"{name}: array {key!r}: not numbers ({exc})") from None
+        if a.shape[1:] != shape[1:] or a.ndim != len(shape):
+            raise LogError(f"{name}: array {key!r}: expected shape {('N',) + shape[1:]}, got "
+                           f"{a.shape}")
+        return a
+
+    triads = {}
+    with npz:
+        for sensor in ("gyro", "accel"):
+            key = find(sensor)
+            if key is not None:
+                triads[sensor] = array(key, (0, 3))
+                continue
+            keys = [find(f"{sensor}_{axis}") for axis in "xyz"]
+            if None in keys:
+                raise LogError(f"{name}: no {sensor} array (expected one (N, 3) array named "
+                               f"{' or '.join(NPZ_ALIASES[sensor][:4])}, ..., or three named "
+                               f"like {sensor}_x; or map it with columns={{{sensor!r}: NAME}}); "
+                               f"the file has {', '.join(files)}")
+            triads[sensor] = np.column_stack([array(k, (0,)) for k in keys])
+        t_key, tick_key, table_key = find("t"), find("tick"), find("table")
+        t = array(t_key, (0,)) if t_key else None
+        if t is None and tick_key is not None:
+            if opt.dt is None:
+                raise LogError(f"{name}: a tick array and no time array: pass dt")
+            t = array(tick_key, (0,)) * opt.dt
+        has_table = table_key is not None if opt.table is None else bool(opt.table)
+        if has_table and table_key is None:
+            raise LogError(f"{name}: table=True, but no table-angle array")
+        table = array(table_key, (0,)) if has_table else None
+    n = triads["gyro"].shape[0]
+    for label, a in (("accel", triads["accel"]), ("time", t), ("table", table)):
+        if a is not None and a.shape[0] != n:
+            raise LogError(f"{name}: the {label} array has {a.shape[0]} samples, the gyro {n}")
+    if t is None:
+        if opt.dt is None:
+            raise LogError(f"{name}: no time array (expected one of "
+                           f"{', '.join(NPZ_ALIASES['t'])}): pass dt")
+        opt.time_col = "none"
+    else:
+        opt.time_col = "first"
+    parts = ([] if t is None else [t[:, None]]) + [triads["gyro"], triads["accel"]]
+    if has_table:
+        parts.append(table[:, None])
+    if n == 0:
+        raise LogError(f"{name}: no samples")
+    return np.hstack(parts), _Samples(n), has_table
+
+
+#: PSINS .imu: the data header's three lines (imufile.m, PSINS base/io)
+PSINS_HEADER = (("pitch0_deg", "roll0_deg", "yaw0_deg", "ve0_mps", "vn0_mps", "vu0_mps"),
+                ("lat0_deg", "lon0_deg", "height0_m", "t0_s", "ts_ms", "g_mps2"),
+                ("gf_x_arcsec", "gf_y_arcsec", "gf_z_arcsec", "af_x_ugs", "af_y_ugs",
+                 "af_z_ugs"))
+
+
+def _parse_psins(path, name, opt):
+    """PSINS's compact SIMU text file (.imu, written and read by PSINS's
+    base/io/imufile.m): '%' comment lines, the first naming 'PSINS' and 'SIMU';
+    three header lines (attitude and velocity; position, t0 [s], the sampling
+    interval [ms] and g [m/s^2]; the gyro scale factors [arcsec] and the
+    accelerometer scale factors [ug*s, ug = 1e-6 of that g]); then integer
+    counts g_x g_y g_z a_x a_y a_z in x-right y-forward z-up axes, and an
+    optional 7th column, the sampling-time dither [us]. Sample k (1-based)
+    is stamped t0 + k ts + 1e-6 sum(dither[1..k]).
+    Returns (values, where, has_table=False, header) in the "first" layout."""
+    lines = _text_lines(path, name)
+    first = next(lines, (1, ""))[1]
+    if "PSINS" not in first or "SIMU" not in first:
+        raise LogError(f"{name}: line 1: not a PSINS-format SIMU file (its first line names "
+                       f"'PSINS' and 'SIMU'), got {first.strip()[:60]!r}")
+    head, rows, numbers, ncol = [], [], [], None
+    for lineno, line in lines:
+        tokens = line.split()
+        if not tokens or tokens[0][0] == "%":
+            continue
+        try:
+            numbers_ = [float(tok) for tok in tokens]
+        except ValueError:
+            bad = next(t for t in tokens if not _is_number(t))
+            raise LogError(f"{name}: line {lineno}: {bad!r} is not a number") from None
+        if len(head) < 3:
+            if len(numbers_) not in (6, 7):
+                raise LogError(f"{name}: line {lineno}: header line {len(head) + 1} of 3 expected "
+                               f"6 numbers ({' '.join(PSINS_HEADER[len(head)])}), got "
+                               f"{len(numbers_)}")
+            head.append(numbers_[:6])
+            continue
+        if ncol is None:
+            if len(numbers_) not in (6, 7):
+                raise LogError(f"{name}: line {lineno}: expected 6 counts (g_x g_y g_z a_x a_y "
+                               f"a_z) or 7 (and the time dither [us]), got {len(numbers_)}")
+            ncol = len(numbers_)
+        elif len(numbers_) != ncol:
+            raise LogError(f"{name}: line {lineno}: expected {ncol} columns like the first data "
+                           f"line, got {len(numbers_)}")
+        rows.append(numbers_)
+        numbers.append(lineno)
+    if len(head) < 3:
+        raise LogError(f"{name}: the PSINS header has {len(head)} of its 3 number lines "
+                       f"({'; '.join(' '.join(h) for h in PSINS_HEADER)})")
+    if not rows:
+        raise LogError(f"{name}: no data lines after the PSINS header")
+    header = {key: value for keys, values in zip(PSINS_HEADER, head)
+              for key, value in zip(keys, values)}
+    ts, g = header["ts_ms"] / 1000.0, header["g_mps2"]
+    if not (np.isfinite(ts) and ts > 0 and np.isfinite(g) and g > 0):
+        raise LogError(f"{name}: header line 2: sampling interval {header['ts_ms']!r} ms and g "
+                       f"{g!r} m/s^2 must be positive")
+    counts = np.array(rows, dtype=float)
+    k = np.arange(1, counts.shape[0] + 1)
+    t = header["t0_s"] + k * ts
+    if ncol == 7:
+        t = t + np.cumsum(counts[:, 6]) * 1e-6
+    values = np.empty((counts.shape[0], 7))
+    values[:, 0] = t
+    # imufile.m: scales = [gf * glv.sec, af * 1e-6 * g] with the header's g
+    values[:, 1:4] = counts[:, 0:3] * (np.array(head[2][0:3]) * ARCSEC_TO_RAD)
+    values[:, 4:7] = counts[:, 3:6] * (np.array(head[2][3:6]) * (1e-6 * g))
+    if opt.dt is None:
+        opt.dt = ts
+    return values, _Lines(np.array(numbers), _columns("first", False)), False, header
+
+
+def _is_number(token):
+    try:
+        float(token)
+        return True
+    except ValueError:
+        return False
 
 
 # ---------------------------------------------------------------------------
@@ -526,8 +911,8 @@ def _check_magnitudes(name, where, kind, gyro_unit, accel_unit, gyro_raw, accel_
     if not lo <= force <= hi:
         fits = [(k, label) for k, unit, label in _ACCEL_READINGS
                 if (k, unit) != (kind, accel_unit) and lo <= as_si(k, unit) <= hi]
-        declared = next(label for k, unit, label in _ACCEL_READINGS
-                        if (k, unit) == (kind, accel_unit))
+        declared = next((label for k, unit, label in _ACCEL_READINGS
+                         if (k, unit) == (kind, accel_unit)), f"{accel_unit} {kind}")
         if fits:
             hint = f"these look like {' or '.join(label for _, label in fits)}, not {declared}"
             if all(k != kind for k, _ in fits):
@@ -548,7 +933,7 @@ def _check_magnitudes(name, where, kind, gyro_unit, accel_unit, gyro_raw, accel_
             hint = (f"the accelerometer says these are {other_kind}, not {kind} "
                     f"(kind={other_kind!r})")
         else:
-            hint = _GYRO_HINTS[kind, gyro_unit]
+            hint = _GYRO_HINTS.get((kind, gyro_unit), "check gyro_unit, the scale and kind")
         issues.append(LogIssue("error", f"{name}: {where.at(k)}: gyro rate {rate[k]:.4g} rad/s "
                                         f"(read as {gyro_unit} {kind}) exceeds "
                                         f"{GYRO_RATE_LIMIT:g} rad/s{more}: {hint}"))
@@ -564,10 +949,21 @@ def _load(path, fmt, options, writing=False):
     plausibility = options.pop("plausibility")
     table_angle = options.pop("table_angle")
     opt = _options(path, fmt, writing=writing, **options)
-    if opt.fmt in ("npz", "csv"):
-        return _load_project(path, name, opt, plausibility, table_angle)
-    if opt.fmt == "text":
+    header = {}
+    if opt.fmt == "npz":
+        parsed = _parse_npz(path, name, opt)
+        if parsed is None:              # the project's own arrays: pyins.sim.io reads them
+            return _load_project(path, name, opt, plausibility, table_angle)
+        values, where, has_table = parsed
+    elif opt.fmt == "text":
         values, where, has_table = _parse_text(path, name, opt)
+    elif opt.fmt == "csv":
+        parsed = _parse_csv(path, name, opt)
+        if parsed[0] is None:           # the project's own header: pyins.sim.io reads it
+            return _load_project(path, name, opt, plausibility, table_angle, text=parsed[1])
+        values, where, has_table = parsed
+    elif opt.fmt == "psins":
+        values, where, has_table, header = _parse_psins(path, name, opt)
     else:
         values, where, has_table = _parse_binary(path, name, opt)
     if has_table and table_angle is not None:
@@ -576,8 +972,8 @@ def _load(path, fmt, options, writing=False):
     if issues:
         return None, issues
     cols = _columns(opt.time_col, has_table)
-    gyro_raw = values[:, cols.index("gyro_x"):cols.index("gyro_x") + 3]
-    accel_raw = values[:, cols.index("accel_x"):cols.index("accel_x") + 3]
+    gyro_raw = values[:, cols.index("gyro_x"):cols.index("gyro_x") + 3] * opt.gyro_scale
+    accel_raw = values[:, cols.index("accel_x"):cols.index("accel_x") + 3] * opt.accel_scale
     n = values.shape[0]
     if opt.time_col == "none":
         t, dt_nom = None, opt.dt
@@ -619,14 +1015,30 @@ def _load(path, fmt, options, writing=False):
                 "axes": opt.axes_spec if isinstance(opt.axes_spec, str) else opt.axes.tolist(),
                 "time_col": opt.time_col, "dt_inferred": opt.dt is None,
                 "t_first": None if t is None else float(t[0])}
+    if opt.gyro_scale != 1.0 or opt.accel_scale != 1.0:
+        metadata.update(gyro_scale=opt.gyro_scale, accel_scale=opt.accel_scale)
+    if header:
+        metadata["psins_header"] = header
     return ImuData(ticks, dtheta_p, dv_p, angle, dt_nom, metadata), issues
 
 
-def _load_project(path, name, opt, plausibility, table_angle):
+def _load_project(path, name, opt, plausibility, table_angle, text=None):
     if table_angle is not None:
         raise ValueError(f"{name}: table_angle does not apply: {opt.fmt} files hold the angle")
+    if opt.fmt in ("csv", "npz"):
+        default = (opt.kind == "increments" and opt.gyro_unit == "rad" and opt.accel_unit == "m/s"
+                   and opt.gyro_scale == 1.0 and opt.accel_scale == 1.0 and opt.columns is None
+                   and opt.table is None and np.array_equal(opt.axes, np.eye(3)))
+        if not default:
+            what = f"csv header ({io.CSV_HEADER})" if opt.fmt == "csv" else "npz file"
+            raise ValueError(f"{name}: the project's {what} holds rad, m/s and the p axes; unit, "
+                             f"axis, scale and column options do not apply")
     try:
-        data = io.load_npz(path) if opt.fmt == "npz" else io.load_csv(path, dt=opt.dt)
+        if opt.fmt == "npz":
+            packed = compression_of(path) is not None
+            data = io.load_npz(path, file=_io.BytesIO(_read_bytes(path, name)) if packed else None)
+        else:
+            data = io.load_csv(path, dt=opt.dt, file=_io.StringIO(text, newline=""))
     except ValueError as exc:
         raise LogError(str(exc)) from exc
     issues = []
@@ -653,14 +1065,17 @@ def _load_project(path, name, opt, plausibility, table_angle):
 
 def read_log(path, fmt=None, *, dt=None, kind="increments", gyro_unit=None, accel_unit=None,
              axes="rfu", time_col=None, table=None, table_unit="rad", table_angle=None,
-             strict=True, plausibility=True):
+             strict=True, plausibility=True, gyro_scale=1.0, accel_scale=1.0, columns=None,
+             strict_hint="read_log(..., strict=False) accepts it"):
     """Read an IMU log into the project's samples.
 
     Parameters
     ----------
     path : str or PathLike
-    fmt : {'npz', 'csv', 'text', 'binary'} or None
-        None: from the extension (.npz, .csv, .txt/.dat/.asc, .bin).
+    fmt : {'npz', 'csv', 'text', 'binary', 'psins'} or None
+        None: from the extension (.npz, .csv, .txt/.dat/.asc, .bin, .imu),
+        looking through .gz/.xz/.bz2. Compressed files are recognised by their
+        first bytes whatever the name.
     dt : float, optional
         Nominal tick length [s]. With a time column the median step must lie
         within 1 % of it; without, it is inferred (median step, to 1 ns).
@@ -688,6 +1103,15 @@ def read_log(path, fmt=None, *, dt=None, kind="increments", gyro_unit=None, acce
         they are returned in ``metadata['warnings']``.
     plausibility : bool
         Check the magnitudes for unit mix-ups (see the module docstring).
+    gyro_scale, accel_scale : float
+        The unit of one count: the file's numbers are multiplied by it, then
+        read in ``gyro_unit``/``accel_unit`` (pulses: ``gyro_unit='arcsec',
+        gyro_scale=0.1`` for 0.1" a pulse). Not for npz or PSINS .imu.
+    columns : dict, optional
+        CSV only: role -> header name for names the reader does not know
+        (roles `CSV_ROLES`: t, tick, gyro_x.., accel_x.., table).
+    strict_hint : str
+        How the caller accepts warnings, named in the strict error.
 
     Returns
     -------
@@ -705,14 +1129,73 @@ def read_log(path, fmt=None, *, dt=None, kind="increments", gyro_unit=None, acce
     data, issues = _load(path, fmt, dict(
         dt=dt, kind=kind, gyro_unit=gyro_unit, accel_unit=accel_unit, axes=axes,
         time_col=time_col, table=table, table_unit=table_unit, table_angle=table_angle,
-        plausibility=plausibility))
+        plausibility=plausibility, gyro_scale=gyro_scale, accel_scale=accel_scale,
+        columns=columns))
     for issue in issues:
         if issue.level == "error":
             raise LogError(issue.message)
     if strict and issues:
-        raise LogError(f"{issues[0].message} (read_log(..., strict=False) accepts it)")
+        raise LogError(f"{issues[0].message} ({strict_hint})")
     data.metadata["warnings"] = [issue.message for issue in issues]
     return data
+
+
+def parse_columns(text, option="columns"):
+    """``"t=stamp,gyro_x=a"`` -> ``{"t": "stamp", "gyro_x": "a"}`` (the CLI's
+    --columns); a malformed list is a ValueError naming ``option``."""
+    pairs = [item.partition("=") for item in text.split(",") if item.strip()]
+    if not pairs or any(not eq or not role.strip() or not col.strip() for role, eq, col in pairs):
+        raise ValueError(f"{option} {text!r}: expected ROLE=NAME,... (roles: "
+                         f"{', '.join(dict.fromkeys(CSV_ROLES + NPZ_ROLES))})")
+    return {role.strip(): col.strip() for role, _, col in pairs}
+
+
+def bridge_gaps(data, how="bridge_gaps"):
+    """``data`` with every skipped tick filled in, and the number of ticks added.
+
+    The rule is the firmware's own for a sequence gap in navigation
+    (docs/core.md, "skipped ticks"): the increments of the j-th of m missing
+    ticks are interpolated linearly between the sample before the gap and the
+    one after it, ``x_prev + (x_next - x_prev) * j / (m + 1)``, the table angle
+    along the shorter turn between its two readings. What moved during the
+    gap is not in the log, so the bridge is a guess that keeps the clock right
+    (each sample is one tick to the firmware): callers say that they used it.
+
+    The result's ``metadata["warnings"]`` is the input's (the gaps as
+    `read_log` found them) and, when ticks were added, a last line saying how
+    many and that ``how`` bridged them.
+    """
+    tick = np.asarray(data.tick, dtype=np.int64)
+    steps = np.diff(tick)
+    gaps = np.nonzero(steps > 1)[0]
+    warnings = list(data.metadata.get("warnings", ()))
+    if gaps.size == 0:
+        data.metadata["warnings"] = warnings
+        return data, 0
+    pieces = {"tick": [], "dtheta_p": [], "dv_p": [], "table_angle_rad": []}
+    start = 0
+    for k in gaps:
+        m = int(steps[k] - 1)
+        j = np.arange(1, m + 1)
+        w = (j / (m + 1.0))[:, None]
+        for key in ("dtheta_p", "dv_p"):
+            a = getattr(data, key)
+            pieces[key] += [a[start:k + 1], a[k] + (a[k + 1] - a[k]) * w]
+        ang = data.table_angle_rad
+        turn = np.mod(ang[k + 1] - ang[k] + np.pi, 2.0 * np.pi) - np.pi
+        pieces["table_angle_rad"] += [ang[start:k + 1], ang[k] + turn * w[:, 0]]
+        pieces["tick"] += [tick[start:k + 1], tick[k] + j]
+        start = k + 1
+    for key in pieces:
+        pieces[key].append((tick if key == "tick" else getattr(data, key))[start:])
+    added = int(np.sum(steps[gaps] - 1))
+    source = data.metadata.get("source", "the log")
+    warnings.append(f"{source}: {_plural(added, 'missing tick')} bridged by linear interpolation "
+                    f"of the neighbouring samples ({how}); the motion in them is not in the log")
+    metadata = dict(data.metadata, bridged_ticks=added, warnings=warnings)
+    return ImuData(np.concatenate(pieces["tick"]), np.concatenate(pieces["dtheta_p"]),
+                   np.concatenate(pieces["dv_p"]), np.concatenate(pieces["table_angle_rad"]),
+                   data.dt, metadata), added
 
 
 def check_log(path, fmt=None, **options):
@@ -726,7 +1209,7 @@ def check_log(path, fmt=None, **options):
     """
     full = dict(dt=None, kind="increments", gyro_unit=None, accel_unit=None, axes="rfu",
                 time_col=None, table=None, table_unit="rad", table_angle=None,
-                plausibility=True)
+                plausibility=True, gyro_scale=1.0, accel_scale=1.0, columns=None)
     unknown = set(options) - set(full)
     if unknown:
         raise TypeError(f"check_log: unknown options {sorted(unknown)}")
@@ -784,8 +1267,29 @@ def write_log(path, data, fmt=None, *, dt=None, kind="increments", gyro_unit=Non
         (``%`` is a comment for MATLAB ``load`` and for `read_log`; pass False
         for tools that take no comment lines, e.g. KF-GINS).
 
-    Floats are written with ``%.17g``, which round-trips every float64.
+    Floats are written with ``%.17g``, which round-trips every float64. A
+    path ending in .gz, .xz or .bz2 is written compressed (the layout from
+    the name without it, as when reading).
     """
+    if format_of(path, fmt) == "psins":
+        raise ValueError(f"{os.fspath(path)}: writing PSINS .imu is not supported (it rounds the "
+                         f"increments to pulse counts); write text, time_col='last', for PSINS")
+    plain, comp = _split_compression(path)
+    if comp is not None:
+        if fmt is None:
+            fmt = format_of(plain)
+        opener = next(o for c, _, o in COMPRESSIONS.values() if c == comp)
+        tmp = f"{plain}.{os.getpid()}.tmp"
+        try:
+            write_log(tmp, data, fmt, dt=dt, kind=kind, gyro_unit=gyro_unit,
+                      accel_unit=accel_unit, axes=axes, time_col=time_col, table=table,
+                      table_unit=table_unit, header=header)
+            with open(tmp, "rb") as src, opener(path, "wb") as dst:
+                dst.write(src.read())
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+        return
     name = os.fspath(path)
     opt = _options(path, fmt, dt=dt, kind=kind, gyro_unit=gyro_unit, accel_unit=accel_unit,
                    axes=axes, time_col=time_col, table=table, table_unit=table_unit,

@@ -59,6 +59,24 @@ class NavErrors:
     #:                          C_b^n(computed) = (I - phi x) C_b^n(true)
 
 
+def _normalize(q):
+    """`pyins.reference.attitude.quat_normalize` over (4, N): unit, w >= 0."""
+    n = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    n = np.where(q[0] < 0.0, -n, n)
+    return q * (1.0 / n)
+
+
+def _rotvec(q):
+    """`pyins.reference.attitude.quat_to_rotvec` over (4, N) unit quaternions
+    with w >= 0: the same small-angle branch (t = r / w < 1e-5)."""
+    r = np.sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    small = r < 1e-5 * q[0]
+    t = r / q[0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(small, 2.0 / q[0] * (1.0 - t * t / 3.0), 2.0 * np.arctan2(r, q[0]) / r)
+    return k * q[1:]
+
+
 def nav_errors(result):
     """Position, velocity and attitude errors of a result with ``outputs``
     (firmware records), ``truth`` (pyins.sim.Truth at the same ticks) and
@@ -69,11 +87,10 @@ def nav_errors(result):
     north = (out["lat_rad"] - lat_t) * (rm + tr.height)
     dlon = np.mod(out["lon_rad"] - tr.lon + np.pi, TWO_PI) - np.pi
     east = dlon * (rn + tr.height) * np.cos(lat_t)
-    att = np.empty((len(out), 3))
-    for k in range(len(out)):
-        # q_err = q_nb(computed) (x) conj(q_nb(true)) = rotation by -phi in n
-        q_err = attitude.quat_mul(out["quat_nb"][k], attitude.quat_conj(tr.quat_nb[k]))
-        att[k] = -attitude.quat_to_rotvec(attitude.quat_normalize(q_err))
+    # q_err = q_nb(computed) (x) conj(q_nb(true)) = rotation by -phi in n: the
+    # mirror's formulas on every record at once ((4, N) arrays, element by element)
+    q_err = attitude.quat_mul(np.asarray(out["quat_nb"]).T, attitude.quat_conj(np.asarray(tr.quat_nb).T))
+    att = -_rotvec(_normalize(q_err)).T
     return NavErrors(time_s=out["tick"] * result.dt, north_m=north, east_m=east,
                      horizontal_m=np.hypot(north, east), vel_n_mps=out["vel_n_mps"] - tr.vel_n,
                      att_n_rad=att)

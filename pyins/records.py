@@ -13,10 +13,21 @@ A variant directory of a run (``pyins.runs``) adds ``timeseries.npz`` and
 Every file that a kill may interrupt is written through a temporary file
 and a rename (`write_atomic`), so a kill at any moment leaves the old file
 or the new one.
+
+A directory being written is locked (`lock_dir`: ``pyins.lock``, a POSIX
+record lock on a file naming the holder's pid, host and start time), so a
+second writer is refused with the holder's name; the kernel drops the lock
+when its process dies, so the lock of a killed run is recognised as stale
+and taken over.
 """
+import datetime
+import errno
+import fcntl
 import hashlib
 import json
 import os
+import socket
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,15 +54,145 @@ class FilResult:
     dt: float
 
 
-def write_atomic(path, text):
-    """Write ``text`` to ``path`` through a temporary file and a rename, so a
-    kill at any moment leaves either the old file or the new one."""
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+def write_atomic(path, text=None, write=None, sync=True):
+    """Write ``text`` to ``path`` (or call ``write(file)`` on a binary file)
+    through a temporary file and a rename, so a kill at any moment leaves
+    either the old file or the new one. ``sync``: fsync before the rename
+    (what a power cut needs; a kill needs only the rename)."""
+    tmp = f"{path}.tmp{os.getpid()}"
+    try:
+        with open(tmp, "w" if write is None else "wb") as f:
+            if write is None:
+                f.write(text)
+            else:
+                write(f)
+            f.flush()
+            if sync:
+                os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+# ---------------------------------------------------------------------------
+# The lock of a directory being written
+# ---------------------------------------------------------------------------
+LOCK = "pyins.lock"
+
+
+class LockedError(ValueError):
+    """The directory is being written by another live process (one line)."""
+
+
+def _holder_text(info):
+    return (f"pid {info.get('pid', '?')} on {info.get('host', '?')}, started {info.get('started', '?')}"
+            + (f" ({info['command']})" if info.get("command") else ""))
+
+
+def is_locked(directory):
+    """The holder (a dict) if a live process holds ``directory``'s lock, else
+    None. Not for a lock this process holds: closing any descriptor of the
+    file drops a POSIX lock of its process."""
+    path = os.path.join(directory, LOCK)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
+    except OSError:
+        return None
+    try:
+        try:
+            # a shared-lock test: F_GETLK through lockf is not offered, so try and drop
+            fcntl.lockf(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except OSError as exc:
+            if exc.errno in (errno.EACCES, errno.EAGAIN):
+                data = os.read(fd, 65536)
+                try:
+                    return json.loads(data.decode() or "null") or {}
+                except ValueError:
+                    return {}
+            return None
+        return None
+    finally:
+        os.close(fd)
+
+
+class DirLock:
+    """A held lock (`lock_dir`); ``release()`` (or the with block) drops it."""
+
+    def __init__(self, fd, path, taken_over):
+        self.fd, self.path, self.taken_over = fd, path, taken_over
+
+    def release(self):
+        if self.fd is None:
+            return
+        try:
+            if os.path.exists(self.path) and os.stat(self.path).st_ino == os.fstat(self.fd).st_ino:
+                os.remove(self.path)
+        finally:
+            os.close(self.fd)
+            self.fd = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+
+
+def lock_dir(directory, what="run directory", notice=None):
+    """Lock ``directory`` (made if missing) for this process: LockedError
+    naming the holder (pid, host, start time) if a live process holds it. A
+    lock left by a process that died (kill -9, a lost machine) is taken
+    over; ``notice(text)`` is told so. Returns a DirLock.
+
+    The lock is a POSIX record lock (fcntl.lockf) on ``pyins.lock``: the
+    kernel drops it when its process dies, it is not inherited by forked
+    children (pool workers), and it works on NFS."""
+    os.makedirs(directory, exist_ok=True)
+    path = os.path.join(directory, LOCK)
+    for _ in range(10):
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        try:
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            data = os.read(fd, 65536)
+            os.close(fd)
+            if exc.errno not in (errno.EACCES, errno.EAGAIN):
+                raise
+            try:
+                holder = json.loads(data.decode() or "null") or {}
+            except ValueError:
+                holder = {}
+            raise LockedError(f"{directory}: this {what} is being written by {_holder_text(holder)}; "
+                              "wait for it to end, or use another directory") from None
+        try:
+            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if not same:                 # released and removed while we waited: try the new file
+            os.close(fd)
+            continue
+        old = os.read(fd, 65536)
+        taken_over = None
+        if old.strip():              # a holder that ended cleanly removes the file: this one died
+            try:
+                taken_over = json.loads(old.decode()) or {}
+            except ValueError:
+                taken_over = {}
+            if notice is not None:
+                notice(f"{directory}: taking over the stale lock of {_holder_text(taken_over)}: "
+                       "that process is gone")
+        me = dict(pid=os.getpid(), host=socket.gethostname(),
+                  started=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
+                  command=" ".join(["pyins" if sys.argv[0].endswith("__main__.py") else os.path.basename(sys.argv[0])]
+                                   + sys.argv[1:])[:200])
+        os.ftruncate(fd, 0)
+        os.lseek(fd, 0, os.SEEK_SET)
+        os.write(fd, json.dumps(me).encode())
+        os.fsync(fd)
+        return DirLock(fd, path, taken_over)
+    raise LockedError(f"{directory}: the lock file {LOCK} keeps changing: another process is taking it")
 
 
 # ---------------------------------------------------------------------------
@@ -63,6 +204,23 @@ def write_records_json(record_dir, every, dt, duration_ticks, done):
         {"outputs.bin": str(native.OUTPUT_DTYPE.descr), "plant.bin": str(PLANT_RECORD_DTYPE.descr),
          "every_ticks": every, "dt_s": dt, "ticks": int(duration_ticks), "ticks_done": int(done),
          "complete": bool(done >= duration_ticks)}, indent=2))
+
+
+def load_written(record_dir):
+    """Every whole record a run wrote to ``record_dir`` up to where it
+    stopped (a Ctrl-C, a kill), past its last checkpoint too: (outputs,
+    plant) memory-mapped, the two cut to the same length; (None, None)
+    when it wrote none. What a report of a stopped run shows; `--resume`
+    continues from the checkpoint instead."""
+    counts = []
+    for name, dtype in _SINKS:
+        path = os.path.join(record_dir, name)
+        counts.append(os.path.getsize(path) // dtype.itemsize if os.path.exists(path) else 0)
+    n = min(counts)
+    if n == 0:
+        return None, None
+    return tuple(np.memmap(os.path.join(record_dir, name), dtype=dtype, mode="r", shape=(n,))
+                 for name, dtype in _SINKS)
 
 
 def load_records(record_dir):
@@ -163,23 +321,30 @@ def write_checkpoint(path, digest, done, n_records, firmware, plant, rng_state):
 # ---------------------------------------------------------------------------
 # A run's variant directory
 # ---------------------------------------------------------------------------
+def timeseries(res):
+    """The arrays of timeseries.npz of a FilResult: every record and its
+    errors against the truth."""
+    e = metrics.nav_errors(res)
+    return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, horizontal_m=e.horizontal_m,
+                vel_err_n_mps=e.vel_n_mps, att_err_n_rad=e.att_n_rad, outputs=np.asarray(res.outputs),
+                plant=np.asarray(res.plant))
+
+
 def write_timeseries(vdir, res):
     """timeseries.npz (every record and its errors) and timeseries.csv (the
     errors, at most CSV_MAX_ROWS rows) of a FilResult."""
-    e = metrics.nav_errors(res)
-    out = np.asarray(res.outputs)
-    np.savez(os.path.join(vdir, "timeseries.npz"), time_s=e.time_s, north_m=e.north_m, east_m=e.east_m,
-             horizontal_m=e.horizontal_m, vel_err_n_mps=e.vel_n_mps, att_err_n_rad=e.att_n_rad,
-             outputs=out, plant=np.asarray(res.plant))
+    arrays = timeseries(res)
+    e, out = metrics.nav_errors(res), arrays["outputs"]
+    write_atomic(os.path.join(vdir, "timeseries.npz"), write=lambda f: np.savez(f, **arrays), sync=False)
     step = max(1, -(-len(out) // CSV_MAX_ROWS))
     k = np.arange(0, len(out), step)
     cols = np.column_stack([e.time_s[k], e.north_m[k], e.east_m[k], e.horizontal_m[k],
                             e.vel_n_mps[k], e.att_n_rad[k] / ARCSEC_TO_RAD,
                             out["table_angle_rad"][k], out["yaw_p_rad"][k], out["mode"][k]])
-    np.savetxt(os.path.join(vdir, "timeseries.csv"), cols, delimiter=",", fmt="%.10g",
-               header="time_s,north_m,east_m,horizontal_m,vel_err_e_mps,vel_err_n_mps,vel_err_u_mps,"
-                      "att_err_e_arcsec,att_err_n_arcsec,att_err_u_arcsec,table_angle_rad,yaw_p_rad,mode",
-               comments="")
+    write_atomic(os.path.join(vdir, "timeseries.csv"), sync=False, write=lambda f: np.savetxt(
+        f, cols, delimiter=",", fmt="%.10g", comments="",
+        header="time_s,north_m,east_m,horizontal_m,vel_err_e_mps,vel_err_n_mps,vel_err_u_mps,"
+               "att_err_e_arcsec,att_err_n_arcsec,att_err_u_arcsec,table_angle_rad,yaw_p_rad,mode"))
 
 
 def load_variant(record_dir, motion, dt):

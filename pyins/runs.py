@@ -1,6 +1,6 @@
-"""Running: a scenario into a run directory (what ``pyins run`` does), one
-run of a scenario, and a recorded IMU log through the firmware (``pyins
-replay``).
+"""Running: a scenario into a run directory (what ``pyins run`` does) and
+one run of a scenario. A recorded log through the firmware (``pyins
+replay``) is `pyins.replay`.
 
 A run directory holds::
 
@@ -13,35 +13,41 @@ A run directory holds::
     <variant>/timeseries.npz   the records and the errors against the truth
     <variant>/timeseries.csv   the errors, at most CSV_MAX_ROWS rows
     *.png, report.html         written by pyins.report
+    pyins.lock                 held while the directory is written
 
 Runs are checkpointed (every CHECKPOINT_S of ship time): ``execute(...,
 resume=True)`` after a kill or Ctrl-C continues each unfinished variant from
-its last checkpoint and skips the finished ones. Ctrl-C leaves a valid partial
-result: summary.json then says ``"complete": false`` and the metrics cover
-the ticks done.
+its last checkpoint and skips the finished ones. summary.json is written at
+the start (``"state": "running"``), after every variant and at the end,
+atomically; Ctrl-C writes it at once (``"complete": false``, ``"state":
+"interrupted"``) and leaves the stopped variant's metrics to the report
+(`pyins.report.run.load` reads its records on disk), so a stop takes under
+a second. A directory being written is locked (`pyins.records.lock_dir`);
+one holding another scenario's run is refused (`check_run_dir`).
 
 Every entry point takes ``engine``: "native" (the compiled firmware and
 plant) or "reference" (their NumPy mirrors, `pyins.engine`).
 """
+import hashlib
 import json
 import os
 import re
 import shutil
+import signal
+import threading
 import time
 
 import numpy as np
 
 from pyins import engine as engines
-from pyins import fil, metrics, native, records, runner, scenario, sim
+from pyins import fil, metrics, native, records, scenario, sim
 from pyins.metrics import group_metrics
 from pyins.records import CSV_MAX_ROWS
-from pyins.reference import abi
-from pyins.reference.fine_align import PHI
-from pyins.reference.firmware import VALID_HEADING_SIGMA
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
+from pyins.units import ARCMIN_TO_RAD, ScenarioError
 
-__all__ = ["execute", "run", "replay", "replay_config", "load_variant", "paper_rows", "slug",
-           "group_metrics", "CHECKPOINT_S", "CSV_MAX_ROWS", "SUMMARY"]
+__all__ = ["execute", "run", "load_variant", "load_written", "paper_rows", "slug",
+           "group_metrics", "check_run_dir", "clean_run_dir", "dir_digest", "read_summary", "scenario_of",
+           "written_ticks", "hold_interrupts", "RunDirError", "CHECKPOINT_S", "CSV_MAX_ROWS", "SUMMARY", "RUN_FILES"]
 
 CHECKPOINT_S = 1800.0          # ship time between checkpoints: 30 min = 180,000 ticks
 SUMMARY = "summary.json"
@@ -68,70 +74,282 @@ def load_variant(run_dir, spec):
     return records.load_variant(os.path.join(run_dir, slug(spec.label), "records"), spec.motion, spec.dt)
 
 
-def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native"):
+class RunDirError(ValueError):
+    """A run directory that cannot be written: it holds another scenario's
+    run, or files that are not a run's (one line)."""
+
+
+#: What a run writes at the top of its directory (`clean_run_dir` removes only these)
+RUN_FILES = (SUMMARY, "scenario.toml", "resolved_scenario.json", "report.html", "errors.png",
+             "alignment.png", "table.png", "comparison.png")
+#: What a directory may hold before a run without being a run's: its lock, a campaign's point.json
+_FOREIGN_OK = (records.LOCK, "point.json")
+
+
+def read_summary(run_dir):
+    """summary.json of ``run_dir`` as a dict, or None (none, or unreadable)."""
+    try:
+        with open(os.path.join(run_dir, SUMMARY)) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def dir_digest(run_dir):
+    """The scenario digest of the run in ``run_dir`` (from summary.json, else
+    from resolved_scenario.json the way `Scenario.digest` computes it), or None."""
+    s = read_summary(run_dir)
+    if s is not None and s.get("digest"):
+        return s["digest"]
+    try:
+        with open(os.path.join(run_dir, "resolved_scenario.json")) as f:
+            res = json.load(f)
+    except (OSError, ValueError):
+        return None
+    res.pop("source", None)
+    blob = json.dumps(res, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def _variant_dirs(run_dir):
+    """The variant directories of the run in ``run_dir`` (those with records)."""
+    out = []
+    for name in sorted(os.listdir(run_dir)):
+        d = os.path.join(run_dir, name)
+        if os.path.isdir(d) and (os.path.isdir(os.path.join(d, "records"))
+                                 or os.path.exists(os.path.join(d, "timeseries.npz"))):
+            out.append(d)
+    return out
+
+
+def check_run_dir(scn, run_dir, force=False):
+    """Refuse (RunDirError) to write ``scn`` into a directory that holds
+    another scenario's run or files that are not a run's; with ``force`` a
+    run of another scenario is removed first (only the files a run writes).
+    Returns "new" (nothing there) or "same" (a run of this scenario)."""
+    if not os.path.isdir(run_dir):
+        return "new"
+    entries = [e for e in os.listdir(run_dir) if e not in _FOREIGN_OK and ".tmp" not in e]
+    if not entries:
+        return "new"
+    old = dir_digest(run_dir)
+    if old is None:
+        raise RunDirError(f"{run_dir}: not empty and not a pyins run directory (it holds "
+                          f"{', '.join(sorted(entries)[:3])}{', ...' if len(entries) > 3 else ''}); "
+                          "give an empty or new --out")
+    if old == scn.digest():
+        return "same"
+    if not force:
+        s = read_summary(run_dir) or {}
+        name = s.get("scenario")
+        what = (f"{name!r} with other values" if name == scn.name else repr(name) if name
+                else "another scenario")
+        raise RunDirError(f"{run_dir}: holds a run of {what} (digest {old[:16]}), not of this {scn.name!r} "
+                          f"(digest {scn.digest()[:16]}): give another --out, or --force to replace it")
+    clean_run_dir(run_dir)
+    return "new"
+
+
+def clean_run_dir(run_dir):
+    """Remove the run in ``run_dir``: the files a run writes and its variant
+    directories; anything else stays."""
+    for d in _variant_dirs(run_dir):
+        shutil.rmtree(d)
+    for name in RUN_FILES:
+        path = os.path.join(run_dir, name)
+        if os.path.exists(path):
+            os.remove(path)
+
+
+def _entry(spec):
+    return dict(label=spec.label, dir=slug(spec.label), ticks=spec.duration_ticks, ticks_done=0,
+                complete=False, wall_s=0.0, metrics={})
+
+
+def written_ticks(run_dir, spec):
+    """The ticks the records on disk of a variant cover (up to where it
+    stopped), 0 if none."""
+    outputs, _ = records.load_written(os.path.join(run_dir, slug(spec.label), "records"))
+    return 0 if outputs is None else int(outputs["tick"][-1])
+
+
+def load_written(run_dir, spec):
+    """Every record a stopped variant wrote (past its last checkpoint too)
+    beside the truth, as a FilResult, or None: what a report of a partial
+    run shows."""
+    outputs, plant = records.load_written(os.path.join(run_dir, slug(spec.label), "records"))
+    if outputs is None:
+        return None
+    truth = sim.truth_at(spec.motion, np.asarray(outputs["tick"]), dt=spec.dt)
+    return records.FilResult(outputs=outputs, plant=plant, truth=truth, dt=spec.dt)
+
+
+def scenario_of(run_dir, summary):
+    """The Scenario a run directory was written from (with its overrides),
+    rebuilt from summary.json's ``scenario_data`` (or scenario.toml when it
+    has the run's digest), or None."""
+    digest = summary.get("digest")
+    path = os.path.join(run_dir, "scenario.toml")
+    text = ""
+    if os.path.exists(path):
+        with open(path) as f:
+            text = f.read()
+    tries = []
+    if summary.get("scenario_data") is not None:
+        tries.append(lambda: scenario.Scenario(text, summary["scenario_data"], summary.get("source") or path,
+                                               summary.get("scenario_stem") or summary.get("scenario")))
+    if text:
+        tries.append(lambda: scenario.loads(text, source=path, name=summary.get("scenario")))
+    for make in tries:
+        try:
+            scn = make()
+        except (ScenarioError, ValueError, TypeError, KeyError, OSError):
+            continue
+        if digest is None or scn.digest() == digest:
+            return scn
+    return None
+
+
+def _write_summary(run_dir, summary):
+    # default=str: a TOML value JSON has no type for (a date) leaves scenario_data unusable, not the summary
+    records.write_atomic(os.path.join(run_dir, SUMMARY), json.dumps(summary, indent=2, default=str))
+
+
+class hold_interrupts:  # noqa: N801 - used as a context manager
+    """Ctrl-C held off while a block that must not be cut writes (a summary,
+    the lock and the first files of a run): ``defer=True`` raises the
+    KeyboardInterrupt when the block ends, ``defer=False`` (already
+    stopping) drops it. Only in the main thread (signal handlers can be set
+    nowhere else: a Dask worker's thread runs without it)."""
+
+    def __init__(self, defer=False):
+        self.defer, self.old, self.caught, self.held = defer, None, False, False
+
+    def _catch(self, signum, frame):
+        self.caught = True
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.old, self.held = signal.signal(signal.SIGINT, self._catch), True
+        return self
+
+    @property
+    def interrupted(self):
+        """A Ctrl-C came during the block that the handler before it would have raised."""
+        return self.caught and callable(self.old)
+
+    def __exit__(self, exc_type, *exc):
+        if not self.held:
+            return
+        # None: a handler set outside Python, which signal.signal cannot put back; the default then
+        signal.signal(signal.SIGINT, self.old if self.old is not None else signal.default_int_handler)
+        if self.defer and self.interrupted and exc_type is None:
+            self.old(signal.SIGINT, None)      # the handler it had: KeyboardInterrupt, as Ctrl-C gives
+
+
+def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native", force=False,
+            notice=None):
     """Run every variant of ``scn`` (a pyins.scenario.Scenario) into
     ``run_dir``; returns the summary dict (also written to summary.json).
 
     ``progress(label)`` returns a callable progress(done, total) per variant
     (e.g. ``lambda label: TextProgress()``); ``log(text)`` gets one line per
-    finished variant. KeyboardInterrupt is caught: the summary of what was
-    done is written (``complete: false``) and the interrupt re-raised.
+    finished variant, ``notice(text)`` the takeover of a stale lock.
+
+    The directory is locked while written (`pyins.records.lock_dir`: a
+    second writer gets LockedError naming the holder). A directory holding
+    another scenario's run is refused (RunDirError) unless ``force``.
+    summary.json is written at the start (``"state": "running"``), after
+    every variant and at the end, each time atomically, so a kill leaves
+    one that `pyins report` reads. KeyboardInterrupt is caught anywhere in
+    the variants: the summary of what was done is written at once
+    (``"complete": false``, ``"state": "interrupted"``; the stopped
+    variant's ticks done, its metrics left to the report) and the interrupt
+    re-raised.
     """
     # the guarded prefix
     engines.check(engine)
+    # the lock and the first files together, Ctrl-C held off: a run that started has a summary
+    lock = None
+    try:
+        with hold_interrupts() as held:
+            lock = records.lock_dir(run_dir, notice=notice)
+            summary, specs, resume = _start(scn, run_dir, resume, engine, force)
+        return _variants(summary, specs, run_dir, progress, resume, log, engine,
+                         KeyboardInterrupt() if held.interrupted else None)
+    finally:
+        if lock is not None:
+            lock.release()
 
-    # 1. the run directory: the scenario as written and as resolved
-    os.makedirs(run_dir, exist_ok=True)
+
+def _start(scn, run_dir, resume, engine, force):
+    # 1. the run directory: refused if another's; the scenario as written and as resolved
+    if check_run_dir(scn, run_dir, force) == "new":
+        resume = False
     src = scn.source if scn.source and os.path.exists(str(scn.source)) else None
-    with open(os.path.join(run_dir, "scenario.toml"), "w") as f:
-        f.write(scn.text)
-    with open(os.path.join(run_dir, "resolved_scenario.json"), "w") as f:
-        f.write(scn.resolved_json())
+    records.write_atomic(os.path.join(run_dir, "scenario.toml"), scn.text)
+    records.write_atomic(os.path.join(run_dir, "resolved_scenario.json"), scn.resolved_json())
+    specs = list(scn.runs())
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
-                   digest=scn.digest(), core_version=native.version(), paper=scn.paper, variants=[],
-                   complete=False)
+                   digest=scn.digest(), core_version=native.version(), paper=scn.paper,
+                   variants=[_entry(spec) for spec in specs], complete=False, state="running",
+                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name))
     if engine != "native":
         summary["engine"] = engine
+    _write_summary(run_dir, summary)
+    return summary, specs, resume
 
+
+def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupted):
     # 2. each variant: the checkpointed run, its records, metrics and time series
-    interrupted = None
-    for spec in scn.runs():
+    for i, spec in enumerate(specs):
         vdir = os.path.join(run_dir, slug(spec.label))
-        if not resume and os.path.exists(vdir):
-            shutil.rmtree(vdir)
-        os.makedirs(vdir, exist_ok=True)
+        entry = summary["variants"][i]
         t0 = time.perf_counter()
-        entry = dict(label=spec.label, dir=slug(spec.label), ticks=spec.duration_ticks)
         try:
-            if interrupted is None:
-                checkpoint = int(round(CHECKPOINT_S / spec.dt))
-                run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
-                    checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint),
-                    progress=progress(spec.label) if progress else None)
+            if interrupted is not None:
+                raise interrupted
+            if not resume and os.path.exists(vdir):
+                shutil.rmtree(vdir)
+            os.makedirs(vdir, exist_ok=True)
+            for name in ("timeseries.npz", "timeseries.csv"):      # derived: rewritten at the end
+                if os.path.exists(os.path.join(vdir, name)):
+                    os.remove(os.path.join(vdir, name))
+            checkpoint = int(round(CHECKPOINT_S / spec.dt))
+            run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
+                checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint),
+                progress=progress(spec.label) if progress else None)
+            res, info = load_variant(run_dir, spec)
+            mm = metrics.run_metrics(spec, res) if res is not None else {}
+            if res is not None and len(res.outputs):
+                records.write_timeseries(vdir, res)
+            entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
+                         complete=bool(info and info.get("complete")), metrics=mm)
         except KeyboardInterrupt as exc:
-            interrupted = exc
-        res, info = load_variant(run_dir, spec)
-        entry["wall_s"] = time.perf_counter() - t0
-        entry["ticks_done"] = int(info["ticks_done"]) if info else 0
-        entry["complete"] = bool(info and info.get("complete"))
-        entry["metrics"] = metrics.run_metrics(spec, res) if res is not None else {}
-        if res is not None and len(res.outputs):
-            records.write_timeseries(vdir, res)
-        summary["variants"].append(entry)
-        if log is not None and interrupted is None:
-            mm = entry["metrics"]
+            # at once: the ticks on disk; the metrics of a stopped variant are the report's
+            interrupted = interrupted or exc.with_traceback(None)
+            with hold_interrupts():
+                entry.update(wall_s=time.perf_counter() - t0, complete=False, metrics={},
+                             ticks_done=written_ticks(run_dir, spec) if os.path.isdir(vdir) else 0)
+            continue
+        if log is not None:
             log(f"  {spec.label}: {entry['ticks_done'] * spec.dt / 3600:.3g} h, "
                 f"max horizontal error {mm.get('horizontal_error_max', float('nan')):.1f} m, "
                 f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
                 f"({entry['wall_s']:.1f} s)")
+        try:
+            with hold_interrupts(defer=True):
+                _write_summary(run_dir, summary)
+        except KeyboardInterrupt as exc:       # during the write (raised after it) or just before
+            interrupted = exc.with_traceback(None)
 
     # 3. the summary, over the variants
-    summary["group_metrics"] = group_metrics(summary["variants"])
-    summary["complete"] = all(v["complete"] for v in summary["variants"])
-    tmp = os.path.join(run_dir, SUMMARY + ".tmp")
-    with open(tmp, "w") as f:
-        json.dump(summary, f, indent=2)
-    os.replace(tmp, os.path.join(run_dir, SUMMARY))
+    with hold_interrupts(defer=interrupted is None):
+        summary["group_metrics"] = group_metrics(summary["variants"])
+        summary["complete"] = all(v["complete"] for v in summary["variants"])
+        summary["state"] = "interrupted" if interrupted is not None else (
+            "complete" if summary["complete"] else "partial")
+        _write_summary(run_dir, summary)
     if interrupted is not None:
         raise interrupted
     return summary
@@ -159,95 +377,3 @@ def paper_rows(summary):
             rows.append(dict(metric=metric, variant=label, relation=fig["relation"], paper=fig["value"],
                              unit=fig["unit"], ours=mine, verdict=verdict, note=fig.get("note", "")))
     return rows
-
-
-# ---------------------------------------------------------------------------
-# Replaying a recorded IMU log
-# ---------------------------------------------------------------------------
-def replay_config(spec):
-    """The firmware configuration replaying a log of ``spec`` (a RunSpec)
-    starts from: its initial state and settings, without indexing (a log's
-    table angles are recorded: the firmware commands nothing)."""
-    cfg = scenario.initial_config(spec.motion, None, **spec.config)
-    cfg["index_scheme"] = 0
-    return cfg
-
-
-_FAULT_NAMES = {v: k[len("PYINS_FAULT_"):] for k, v in vars(abi).items()
-                if k.startswith("PYINS_FAULT_") and isinstance(v, int)}
-
-
-def _replay_warnings(recs, aligning, hz):
-    """What a replay's figures cannot be trusted for, in words: a log that
-    ended before the alignment did, an attitude the firmware does not call
-    valid, fault bits."""
-    out = []
-    last = recs[-1]
-    t = float(last["tick"] / hz)
-    if aligning and last["mode"] != abi.PYINS_MODE_NAVIGATE:
-        phase = {abi.PYINS_MODE_COARSE_ALIGN: "coarse", abi.PYINS_MODE_FINE_ALIGN: "fine"}.get(
-            int(last["mode"]), "the")
-        out.append(f"the log ended during {phase} alignment (at {t:g} s): no aligned attitude")
-    if not last["state_flags"] & abi.PYINS_STATE_ATT_VALID:
-        integrity = abi.PYINS_FAULT_ALIGN_INCONSISTENT | abi.PYINS_FAULT_COARSE_UNSETTLED
-        heading_sigma = float(last["kf_sigma"][PHI][2]) if last["kf_states"] else 0.0
-        if int(last["fault_flags"]) & integrity:
-            why = "an integrity test failed: the measurements do not fit the alignment's model"
-        elif heading_sigma > VALID_HEADING_SIGMA:
-            why = (f"the fine alignment left a heading sigma of {heading_sigma / ARCMIN_TO_RAD:.1f}', above "
-                   f"{VALID_HEADING_SIGMA / ARCMIN_TO_RAD:g}': align longer")
-        elif aligning:
-            why = "the alignment had not ended"
-        else:
-            why = "it is the configured guess"
-        out.append(f"the attitude at the end ({t:g} s) is not valid (ATT_VALID unset): {why}")
-    faults = [name for bit, name in sorted(_FAULT_NAMES.items()) if bit and int(last["fault_flags"]) & bit]
-    if faults:
-        out.append("fault bits set: " + ", ".join(faults))
-    return out
-
-
-def replay(data, cfg, out_dir, every=100, spec=None, engine="native", log_path=None):
-    """Run a recorded IMU log (``data``: a pyins.sim.io.ImuData) through the
-    firmware configured by ``cfg`` into ``out_dir``: navigation.npz (the
-    records every ``every`` samples) and summary.json (the final state and,
-    with the ``spec`` the log was simulated from, the errors against its
-    truth). Returns the summary dict."""
-    # the guarded prefix
-    engines.check(engine)
-    every = max(1, int(every))
-
-    # 1. the log through the firmware
-    fw = engines.firmware(engine, cfg)
-    samples = native.make_samples(np.ascontiguousarray(data.dtheta_p), np.ascontiguousarray(data.dv_p),
-                                  np.ascontiguousarray(data.table_angle_rad))
-    os.makedirs(out_dir, exist_ok=True)
-    recs = fw.run(samples, every=every)
-    np.savez(os.path.join(out_dir, "navigation.npz"), outputs=recs)
-
-    # 2. the final state, and the errors against the truth when it is known
-    summary = dict(log=os.path.abspath(log_path) if log_path else None, samples=int(len(samples)),
-                   every=every,
-                   final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
-                              lon_deg=float(np.degrees(recs["lon_rad"][-1])),
-                              euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
-                              mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
-    hz = cfg.get("tick_hz") or TICK_HZ
-    aligning = cfg.get("coarse_ticks", 0) > 0 or cfg.get("fine_ticks", 0) > 0
-    nav = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE)
-    if aligning and len(nav):
-        k = nav[0]
-        pitch, roll, yaw = np.degrees(recs["euler_b_rad"][k])
-        summary["aligned"] = dict(time_s=float(recs["tick"][k] / hz), pitch_deg=float(pitch),
-                                  roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)))
-    summary["warnings"] = _replay_warnings(recs, aligning, hz)
-    if spec is not None:
-        truth = sim.truth_at(spec.motion, recs["tick"], dt=spec.dt)
-        e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=spec.dt))
-        summary["errors"] = dict(horizontal_max_m=float(e.horizontal_m.max()),
-                                 horizontal_final_m=float(e.horizontal_m[-1]),
-                                 heading_final_arcmin=float(e.att_n_rad[-1, 2] / ARCMIN_TO_RAD),
-                                 level_max_arcsec=float(np.abs(e.att_n_rad[:, :2]).max() / ARCSEC_TO_RAD))
-    with open(os.path.join(out_dir, "summary.json"), "w") as f:
-        json.dump(summary, f, indent=2)
-    return summary

@@ -40,12 +40,12 @@ campaign itself sets the compared key (a grid key, a fixed override, or
 the guide.
 """
 from pyins.campaign.aggregate import STATS, aggregate
-from pyins.campaign.execute import CampaignError, pending, run_campaign
+from pyins.campaign.execute import CampaignError, CampaignInterrupted, pending, run_campaign
 from pyins.campaign.grid import parse_grid, parse_value
 from pyins.campaign.spec import (Campaign, Point, builtin_path, default_out_dir, from_args, list_builtin,
                                  load_campaign, loads_campaign)
 from pyins.units import ScenarioError
 
 __all__ = ["Campaign", "Point", "CampaignError", "ScenarioError", "load_campaign", "loads_campaign",
-           "from_args", "parse_grid", "parse_value", "run_campaign", "aggregate", "pending",
+           "from_args", "parse_grid", "parse_value", "run_campaign", "CampaignInterrupted", "aggregate", "pending",
            "list_builtin", "builtin_path", "default_out_dir", "STATS"]

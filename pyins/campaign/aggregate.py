@@ -28,6 +28,7 @@ import numpy as np
 
 from pyins.campaign.grid import show
 from pyins.metrics import GROUP_METRICS, NAMES, describe, dimension, display, group_metrics, si_name
+from pyins.records import write_atomic
 from pyins.report import campaign as campaign_report
 
 __all__ = ["aggregate", "plan", "metric_order", "read_summary", "write_json", "STATS",
@@ -48,11 +49,7 @@ def read_summary(run_dir):
 
 def write_json(path, obj):
     """``obj`` as JSON into ``path``, atomically (a kill leaves the old file or the new)."""
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as f:
-        json.dump(obj, f, indent=2, allow_nan=False)
-        f.write("\n")
-    os.replace(tmp, path)
+    write_atomic(path, json.dumps(obj, indent=2, allow_nan=False) + "\n", sync=False)
 
 
 def plan(camp):
@@ -143,8 +140,7 @@ def aggregate(camp, out_dir, plots=True):
     write_json(os.path.join(out_dir, "campaign.json"), result)
     _write_csv(camp, out_dir, result)
     _write_runs_csv(camp, out_dir, result)
-    with open(os.path.join(out_dir, "aggregate.md"), "w") as f:
-        f.write(campaign_report.markdown(camp, result, rows))
+    write_atomic(os.path.join(out_dir, "aggregate.md"), campaign_report.markdown(camp, result, rows), sync=False)
     if plots:
         campaign_report.plots(camp, out_dir, result, rows)
     return result
@@ -166,8 +162,7 @@ def _write_csv(camp, out_dir, result):
         g = camp.groups[a["group"]]["values"]
         w.writerow([a["group"], *(show(g[k]) for k in camp.group_by), a["variant"] or "", a["metric"],
                     a["count"], *([""] * (len(STATS) - 1)), _fmt(a["value"])])
-    with open(os.path.join(out_dir, "aggregate.csv"), "w") as f:
-        f.write(buf.getvalue())
+    write_atomic(os.path.join(out_dir, "aggregate.csv"), buf.getvalue(), sync=False)
 
 
 def _write_runs_csv(camp, out_dir, result):
@@ -180,6 +175,5 @@ def _write_runs_csv(camp, out_dir, result):
             w.writerow([p["index"], *(show(p["values"][k]) for k in camp.grid),
                         "" if p["run"] is None else p["run"], "" if p["seed"] is None else p["seed"],
                         p["group"], label, p["digest"][:16], *(_fmt(m.get(n)) for n in names)])
-    with open(os.path.join(out_dir, "runs.csv"), "w") as f:
-        f.write(buf.getvalue())
+    write_atomic(os.path.join(out_dir, "runs.csv"), buf.getvalue(), sync=False)
 

@@ -20,20 +20,36 @@ file system) and have the same pyins installed; dask is imported only then.
    recorded as it finishes or fails;
 3. the aggregates (`pyins.campaign.aggregate`), and campaign.json with what
    was computed, skipped or failed.
+
+The campaign directory is locked while a campaign runs into it
+(`pyins.records.lock_dir`): a second campaign into the same directory is
+refused with the holder's pid, host and start time. Ctrl-C (SIGINT to the
+whole process group, as a terminal sends it, or to this process alone)
+stops the campaign within a few seconds: no further run is started, the
+runs in flight are interrupted (each writes its partial summary and keeps
+its checkpoint), the finished runs are kept, the aggregates of what
+finished are written (campaign.json ``"complete": false``, its
+``execution.interrupted`` true; no plots) and `CampaignInterrupted` (a
+KeyboardInterrupt) is raised. Running the campaign again resumes it.
 """
 import copy
 import json
 import os
+import signal
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-from pyins import runs
+from pyins import records, runs
 from pyins import scenario as scenario_mod
 from pyins.campaign.aggregate import aggregate, plan, read_summary, write_json
 
-__all__ = ["CampaignError", "run_campaign", "pending", "DASK_CONNECT_TIMEOUT"]
+__all__ = ["CampaignError", "CampaignInterrupted", "run_campaign", "pending", "DASK_CONNECT_TIMEOUT",
+           "STOP_GRACE_S"]
 
 DASK_CONNECT_TIMEOUT = "20s"   #: how long to wait for a Dask scheduler
+#: After Ctrl-C: how long the runs in flight get to write their partial
+#: summaries (each takes well under a second) before the pool is killed
+STOP_GRACE_S = (1.0, 3.0)      # (wait for the terminal's own SIGINT, then after forwarding it)
 
 
 class CampaignError(RuntimeError):
@@ -42,6 +58,15 @@ class CampaignError(RuntimeError):
 
     def __init__(self, message, result=None):
         super().__init__(message)
+        self.result = result
+
+
+class CampaignInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a campaign; ``result``: the campaign.json written with
+    what had finished (``execution``: computed, interrupted, not started)."""
+
+    def __init__(self, result=None):
+        super().__init__("campaign interrupted")
         self.result = result
 
 
@@ -65,23 +90,41 @@ def _run_point(task):
                             f"{digest[:16]}, not {task['digest'][:16]}): install the same pyins on "
                             f"every worker")
     run_dir = task["run_dir"]
-    os.makedirs(run_dir, exist_ok=True)
     point_json = os.path.join(run_dir, "point.json")
-    if os.path.exists(point_json):
-        with open(point_json) as f:
-            old = json.load(f)
-        if old.get("digest") != digest:
-            raise CampaignError(f"{run_dir} belongs to another scenario (digest {old.get('digest')})")
-    else:
-        write_json(point_json, {"digest": digest, "base": base.name, "base_source": str(task["source"]),
-                                "overrides": task["overrides"]})
+    with runs.hold_interrupts(defer=True):      # point.json whole or not at all
+        os.makedirs(run_dir, exist_ok=True)
+        if os.path.exists(point_json):
+            with open(point_json) as f:
+                old = json.load(f)
+            if old.get("digest") != digest:
+                raise CampaignError(f"{run_dir} belongs to another scenario (digest {old.get('digest')})")
+        else:
+            write_json(point_json, {"digest": digest, "base": base.name, "base_source": str(task["source"]),
+                                    "overrides": task["overrides"]})
+    notices = []           # a stale lock taken over (a killed earlier attempt), told by run_campaign
     try:
-        summary = runs.execute(scn, run_dir, resume=True)
+        summary = runs.execute(scn, run_dir, resume=True, notice=notices.append)
     except ValueError as exc:
         if "checkpoint belongs to another run" not in str(exc):
             raise
         summary = runs.execute(scn, run_dir, resume=False)   # a checkpoint of an older pyins
-    return {"digest": digest, "wall_s": time.perf_counter() - t0, "summary": summary}
+    return {"digest": digest, "wall_s": time.perf_counter() - t0, "summary": summary, "notices": notices}
+
+
+def _pool_init():
+    """A pool worker ignores Ctrl-C while idle (a KeyboardInterrupt there
+    would kill it outside any task); `_pool_point` takes it during a run."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _pool_point(task):
+    """`_run_point` in a pool worker: Ctrl-C interrupts the run (which then
+    writes its partial summary), not the idle worker."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        return _run_point(task)
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def pending(camp, out_dir):
@@ -117,33 +160,77 @@ def _first_line(exc):
     return text.splitlines()[0] if text else type(exc).__name__
 
 
-def _run_local(tasks, workers, on_done):
+def _run_local(tasks, workers, on_done, on_stopped):
+    """Run ``tasks`` in this process (workers == 1) or on a pool of
+    ``workers`` processes, at most ``workers`` at a time (so that nothing
+    waits in the pool's queue to start after a Ctrl-C)."""
     if workers == 1:
         for t in tasks:
             try:
                 on_done(t, _run_point(t), None)
             except KeyboardInterrupt:
+                on_stopped(t)
                 raise
             except Exception as exc:             # noqa: BLE001 - recorded, the others go on
                 on_done(t, None, exc)
         return "local, in process"
-    ex = ProcessPoolExecutor(max_workers=workers)
-    futs = {}
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_pool_init)
+    waiting = iter(tasks)
+    running = {}
     try:
-        futs = {ex.submit(_run_point, t): t for t in tasks}
-        for f in as_completed(futs):
-            exc = f.exception()
-            on_done(futs[f], None if exc else f.result(), exc)
+        for t in waiting:
+            running[ex.submit(_pool_point, t)] = t
+            if len(running) >= workers:
+                break
+        while running:
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for f in done:
+                t = running.pop(f)
+                exc = f.exception()
+                if isinstance(exc, KeyboardInterrupt):   # the terminal's Ctrl-C reached the worker first
+                    on_stopped(t)
+                    raise KeyboardInterrupt
+                on_done(t, None if exc else f.result(), exc)
+                nxt = next(waiting, None)
+                if nxt is not None:
+                    running[ex.submit(_pool_point, nxt)] = nxt
+    except KeyboardInterrupt:
+        with runs.hold_interrupts():
+            _stop_pool(ex, running, on_done, on_stopped)
+        raise
     except BaseException:
-        for f in futs:
-            f.cancel()
         ex.shutdown(wait=False, cancel_futures=True)
         raise
     ex.shutdown(wait=True)
     return f"local process pool, {workers} worker(s)"
 
 
-def _run_dask(tasks, scheduler, on_done):
+def _stop_pool(ex, running, on_done, on_stopped):
+    """After Ctrl-C: let the runs in flight write their partial summaries
+    (a terminal's SIGINT reached them too; else it is forwarded), keep any
+    that finished meanwhile, then end the pool (killing what still runs)."""
+    _, left = wait(running, timeout=STOP_GRACE_S[0])
+    if left:
+        # concurrent.futures offers no public list of its worker processes
+        for pid in list(getattr(ex, "_processes", None) or {}):
+            try:
+                os.kill(pid, signal.SIGINT)
+            except OSError:
+                pass
+        _, left = wait(left, timeout=STOP_GRACE_S[1])
+    for f, t in running.items():
+        exc = None if f.cancelled() or not f.done() else f.exception()
+        if f.done() and not f.cancelled() and not isinstance(exc, KeyboardInterrupt):
+            on_done(t, None if exc else f.result(), exc)
+        else:
+            on_stopped(t)
+    if left:
+        for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            proc.kill()
+    ex.shutdown(wait=not left, cancel_futures=True)
+
+
+def _run_dask(tasks, scheduler, on_done, on_stopped):
     try:
         import distributed
     except ImportError:
@@ -171,6 +258,9 @@ def _run_dask(tasks, scheduler, on_done):
                 f.release()
         except BaseException:
             client.cancel(futs)
+            for f in futs:
+                if not f.done() or f.cancelled():
+                    on_stopped(index[f.key])
             raise
     finally:
         if own:
@@ -178,7 +268,8 @@ def _run_dask(tasks, scheduler, on_done):
     return f"dask {address}"
 
 
-def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log=None, plots=True):
+def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log=None, plots=True,
+                 notice=None):
     """Run the campaign's missing runs into ``out_dir`` and aggregate.
 
     ``workers``: processes of the local pool (default os.cpu_count(); 1 runs
@@ -186,15 +277,26 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
     ("tcp://host:8786") or a ``distributed.Client``, instead of the local
     pool. ``progress(done, total, skipped)`` is called once before running
     (done = skipped: the runs found complete) and after every run;
-    ``log(line)`` gets a line per finished or failed run. Returns the
-    campaign.json dict (its ``execution`` entry says what was computed,
-    skipped or failed, and the wall time: everything else is the same
-    whichever way and in however many pieces the campaign ran). If runs
-    failed, every result is still written and CampaignError is raised
-    (``.result``: that dict).
+    ``log(line)`` gets a line per finished or failed run, ``notice(line)``
+    the takeover of a stale lock. Returns the campaign.json dict (its
+    ``execution`` entry says what was computed, skipped or failed, and the
+    wall time: everything else is the same whichever way and in however
+    many pieces the campaign ran). If runs failed, every result is still
+    written and CampaignError is raised (``.result``: that dict). Ctrl-C:
+    the partial aggregates are written and CampaignInterrupted raised.
+    ``out_dir`` is locked while the campaign runs (LockedError names the
+    holder).
     """
     t0 = time.perf_counter()
     out_dir = str(out_dir)
+    lock = records.lock_dir(out_dir, what="campaign directory", notice=notice)
+    try:
+        return _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notice, t0)
+    finally:
+        lock.release()
+
+
+def _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notice, t0):
     os.makedirs(os.path.join(out_dir, "runs"), exist_ok=True)
     # 1. what is missing
     todo, total = pending(camp, out_dir)
@@ -203,7 +305,7 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
                dict(plan(camp), complete=False, note="running: aggregates are written at the end"))
     if progress:
         progress(skipped, total, skipped)
-    state = {"done": skipped, "computed": 0, "failed": []}
+    state = {"done": skipped, "computed": 0, "failed": [], "interrupted": []}
     tasks = _tasks(camp, out_dir, todo)
 
     def on_done(task, result, exc):
@@ -215,7 +317,9 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
                 log(f"  FAILED {task['label']}: {_first_line(exc)}")
         else:
             state["computed"] += 1
-            if not os.path.exists(os.path.join(task["run_dir"], "summary.json")):
+            for text in result.get("notices", ()) if notice else ():
+                notice(text)
+            if not _is_done(task["run_dir"], task["digest"]):
                 # a Dask worker without the shared file system: keep its summary here
                 os.makedirs(task["run_dir"], exist_ok=True)
                 write_json(os.path.join(task["run_dir"], "summary.json"), result["summary"])
@@ -224,24 +328,41 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
         if progress:
             progress(state["done"], total, skipped)
 
-    # 2. run it, locally or on Dask
-    how = "nothing to run"
-    if tasks:
-        if scheduler is not None:
-            how = _run_dask(tasks, scheduler, on_done)
+    def on_stopped(task):
+        if _is_done(task["run_dir"], task["digest"]):     # it finished as the Ctrl-C came
+            state["done"] += 1
+            state["computed"] += 1
         else:
-            n = workers or os.cpu_count() or 1
-            how = _run_local(tasks, max(1, min(n, len(tasks))), on_done)
-    # 3. the aggregates
-    result = aggregate(camp, out_dir, plots=plots)
-    result["execution"] = {"scheduler": how, "runs": total, "computed": state["computed"],
-                           "skipped": skipped, "failed": state["failed"],
-                           "wall_s": time.perf_counter() - t0}
-    write_json(os.path.join(out_dir, "campaign.json"), result)
+            state["interrupted"].append({"digest": task["digest"], "label": task["label"]})
+
+    # 2. run it, locally or on Dask
+    how, interrupted = "nothing to run", False
+    try:
+        if tasks:
+            if scheduler is not None:
+                how = _run_dask(tasks, scheduler, on_done, on_stopped)
+            else:
+                n = workers or os.cpu_count() or 1
+                how = _run_local(tasks, max(1, min(n, len(tasks))), on_done, on_stopped)
+    except KeyboardInterrupt:
+        interrupted = True
+        how = "interrupted (Ctrl-C)"
+    # 3. the aggregates (of what finished, without plots, after a Ctrl-C)
+    with runs.hold_interrupts():
+        result = aggregate(camp, out_dir, plots=plots and not interrupted)
+        ended = state["computed"] + len(state["failed"]) + len(state["interrupted"])
+        result["execution"] = {"scheduler": how, "runs": total, "computed": state["computed"],
+                               "skipped": skipped, "failed": state["failed"],
+                               "wall_s": time.perf_counter() - t0}
+        if interrupted:
+            result["execution"].update(interrupted=True, stopped=state["interrupted"],
+                                       not_started=len(tasks) - ended)
+        write_json(os.path.join(out_dir, "campaign.json"), result)
+    if interrupted:
+        raise CampaignInterrupted(result)
     if state["failed"]:
         f = state["failed"][0]
         raise CampaignError(f"{len(state['failed'])} of {total} runs failed (first: {f['label']}: "
                             f"{f['error']}); the results cover the others. Run the campaign again "
                             f"to retry them.", result)
     return result
-

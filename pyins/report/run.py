@@ -20,25 +20,54 @@ import os
 
 import numpy as np
 
-from pyins import runs
+from pyins import metrics, records, runs
 from pyins.metrics import FIGURE_METRICS, display
 from pyins.report.plotting import pyplot
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, UNITS
 
-__all__ = ["render", "plot_errors", "plot_alignment", "plot_table", "plot_comparison"]
+__all__ = ["render", "load", "plot_errors", "plot_alignment", "plot_table", "plot_comparison"]
 
 _MIN, _HOUR = UNITS["time"]["min"], UNITS["time"]["h"]
 
 
-def _load(run_dir):
-    with open(os.path.join(run_dir, "summary.json")) as f:
-        summary = json.load(f)
+def load(run_dir):
+    """summary.json and the variants' series. A partial run (Ctrl-C, a kill,
+    or one being written) is read as far as its records go: each unfinished
+    variant's records on disk beside the truth of the scenario the run was
+    written from, its metrics computed here (summary.json is left as it is);
+    ``summary["stopped"]`` says how it stands."""
+    summary = runs.read_summary(run_dir)
+    if summary is None:
+        raise FileNotFoundError(f"{run_dir}: not a run directory (no readable {runs.SUMMARY})")
+    unfinished = [v for v in summary["variants"] if not v.get("complete")]
+    scn = runs.scenario_of(run_dir, summary) if unfinished else None
+    specs = {spec.label: spec for spec in scn.runs()} if scn is not None else {}
     series = {}
     for v in summary["variants"]:
         path = os.path.join(run_dir, v["dir"], "timeseries.npz")
-        if os.path.exists(path):
+        spec = specs.get(v["label"])
+        if not v.get("complete") and spec is not None:
+            res = runs.load_written(run_dir, spec)
+            if res is not None:
+                series[v["label"]] = records.timeseries(res)
+                v["ticks_done"] = int(res.outputs["tick"][-1])
+                v["metrics"] = metrics.run_metrics(spec, res)
+        elif os.path.exists(path):
             with np.load(path, allow_pickle=False) as z:
                 series[v["label"]] = {k: z[k] for k in z.files}
+    if unfinished:
+        holder = records.is_locked(run_dir)
+        if holder is not None:
+            summary["stopped"] = f"being written by pid {holder.get('pid', '?')} on {holder.get('host', '?')}"
+        elif summary.get("state") == "interrupted":
+            summary["stopped"] = "interrupted (Ctrl-C)"
+        elif summary.get("state") == "running":
+            summary["stopped"] = "stopped while running (killed or crashed)"
+        else:
+            summary["stopped"] = "interrupted"
+        if scn is None:
+            summary["stopped"] += "; the scenario could not be rebuilt, so only the finished variants are shown"
+        summary["group_metrics"] = metrics.group_metrics(summary["variants"])
     return summary, series
 
 
@@ -166,9 +195,10 @@ def _ours(row):
     return "" if row["ours"] is None else f"{row['ours']:.4g} {row['unit']}"
 
 
-def render(run_dir):
-    """Write the plots and report.html into ``run_dir``; returns the path."""
-    summary, series = _load(run_dir)
+def render(run_dir, loaded=None):
+    """Write the plots and report.html into ``run_dir``; returns the path.
+    ``loaded``: what `load` returned for it (else it is read here)."""
+    summary, series = loaded if loaded is not None else load(run_dir)
     # 1. the figures
     figs = []
     if series:
@@ -210,7 +240,8 @@ def render(run_dir):
     if os.path.exists(scen_path):
         with open(scen_path) as f:
             scen_text = f.read()
-    status = "complete" if summary["complete"] else "PARTIAL (interrupted): figures cover the ticks done"
+    status = "complete" if summary["complete"] else (
+        f"PARTIAL ({summary.get('stopped', 'interrupted')}): figures cover the ticks done")
     imgs = "".join(f"<figure><img src='{esc(p)}' alt='{esc(c)}'><figcaption>{esc(c)}</figcaption></figure>"
                    for p, c in figs)
     page = f"""<!DOCTYPE html>
@@ -237,6 +268,5 @@ core {esc(summary['core_version'])}. Status: {esc(status)}.</p>
 </body></html>
 """
     path = os.path.join(run_dir, "report.html")
-    with open(path, "w") as f:
-        f.write(page)
+    records.write_atomic(path, page, sync=False)
     return path

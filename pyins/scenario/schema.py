@@ -262,7 +262,9 @@ FIRMWARE_KEYS = {
     "fine_accel_vrw": Key("velocity_random_walk", "filter R: accelerometer VRW (firmware default "
                                                   "10 ug/sqrt(Hz))", lo="0 ug/sqrt(Hz)",
                           hi="10 mg/sqrt(Hz)", lo_open=True),
-    "fine_sigma0_att": _angle("initial sigma of phi E, N, U (firmware default 100', 100', 600')",
+    "fine_sigma0_att": _angle("initial sigma of phi E, N, U (firmware default: fitted to the coarse "
+                              "result after a coarse alignment, else 100', 100', 600'; 1', 1', 10' "
+                              "for the moving-base filter)",
                               None, "0 deg", "180 deg", lo_open=True, shape=3),
     "fine_sigma0_gyro": Key("angular_rate", "initial sigma of the drifts (firmware default "
                                             "0.01 deg/h)", lo="0 deg/h", hi="1 deg/s",

@@ -86,11 +86,13 @@ def save_npz(path, dtheta_p, dv_p, table_angle_rad, dt, metadata=None, tick=None
                  metadata=np.array(meta))
 
 
-def load_npz(path):
-    """Read a file written by `save_npz`; returns `ImuData`."""
+def load_npz(path, file=None):
+    """Read a file written by `save_npz`; returns `ImuData`. ``file``: a binary
+    file object to read instead of opening ``path`` (pyins.logs hands in
+    decompressed bytes)."""
     name = os.fspath(path)
     try:
-        npz = np.load(path, allow_pickle=False)
+        npz = np.load(path if file is None else file, allow_pickle=False)
     except (OSError, ValueError) as exc:
         raise ValueError(f"{name}: not a readable .npz file ({exc})") from exc
     with npz:
@@ -129,7 +131,7 @@ def _parse_tick(text, where):
         raise ValueError(f"{where}: tick {text.strip()!r} is not an integer") from None
 
 
-def load_csv(path, dt=None):
+def load_csv(path, dt=None, file=None):
     """Read a CSV written by `save_csv` (or by hand in the same layout).
 
     Blank lines are skipped. Fields may carry surrounding spaces.
@@ -139,6 +141,9 @@ def load_csv(path, dt=None):
     path : str or PathLike
     dt : float, optional
         Tick length to record in the result (the CSV does not store it).
+    file : text file object, optional
+        Read from it instead of opening ``path`` (which still names the file
+        in messages): pyins.logs hands in decompressed text.
 
     Returns
     -------
@@ -147,7 +152,7 @@ def load_csv(path, dt=None):
     name = os.fspath(path)
     ncol = len(CSV_COLUMNS)
     ticks, values = [], []
-    with open(path, "r", newline="") as f:
+    with (open(path, "r", newline="") if file is None else file) as f:
         header = f.readline()
         if header.rstrip("\r\n").lstrip("\ufeff").strip() != CSV_HEADER:
             raise ValueError(f"{name}: line 1: header must be {CSV_HEADER!r}, "

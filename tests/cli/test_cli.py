@@ -138,7 +138,9 @@ def test_ctrl_c_leaves_a_partial_result_that_resume_completes(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert not summary["complete"]
     v = summary["variants"][0]
-    assert 0 < v["ticks_done"] < v["ticks"] and v["metrics"]["horizontal_error_max"] > 0
+    assert 0 < v["ticks_done"] < v["ticks"]
+    # the metrics of the stopped variant are the report's (Ctrl-C does not wait for them)
+    assert cli.main(["report", str(out), "--quiet"]) == 0
     assert (out / "report.html").exists()
     done_before = v["ticks_done"]
     assert cli.main(["run", "seed003", "--out", str(out), "--resume", "--quiet"]) == 0

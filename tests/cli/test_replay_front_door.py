@@ -143,3 +143,50 @@ def test_make_samples_takes_the_columns_of_a_text_log(two_rates):
     d = logs.read_log(str(two_rates[0]), time_col="first", axes="frd")
     s = native.make_samples(d.dtheta_p, d.dv_p, d.table_angle_rad)
     assert len(s) == len(d.tick) and np.array_equal(s["dv_p_mps"], d.dv_p)
+
+
+def test_a_replay_writes_a_report_with_the_alignment_and_the_errors_against_the_site(tmp_path, two_rates):
+    """Defect 10 (first part): replay wrote no report and no plots. With
+    ``--reference parked`` the errors are against the site and zero velocity."""
+    rc, s = _replay(tmp_path, two_rates[1], "--coarse", "30", "--fine", "25", "--reference", "parked")
+    assert rc == 0
+    out = tmp_path / "out"
+    for f in ("report.html", "attitude.png", "alignment.png", "errors.png", "errors.npz"):
+        assert (out / f).exists(), f
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "aligned attitude" in page and "heading sigma" in page and "against the site" in page
+    fa = s["fine_alignment"]
+    assert fa["states"] == 5 and fa["sigma_heading_arcmin"] > 0 and len(fa["drift_nu_dph"]) == 2
+    # error-free increments of a parked vehicle: it stays within centimetres of
+    # the site over 55 s (a wrong rate or attitude gives metres to kilometres)
+    er = s["errors"]
+    assert er["reference"].startswith("the site") and er["horizontal_max_m"] < 0.1
+    with np.load(out / "errors.npz") as z:
+        assert set(z.files) == {"time_s", "north_m", "east_m", "vel_n_mps"}
+    # pyins report re-renders a replay directory
+    (out / "report.html").unlink()
+    assert cli.main(["report", str(out), "--quiet"]) == 0 and (out / "report.html").exists()
+
+
+def test_a_log_shorter_than_one_record_is_a_clear_error(tmp_path, capsys):
+    """Was an IndexError ("internal error", exit 1) at the first record."""
+    log = _text_log(tmp_path / "short.txt", 100, seconds=0.5)
+    rc, _ = _replay(tmp_path, log, "--attitude", "0", "0", "-90.8")
+    assert rc == cli.EXIT_INPUT
+    assert "fewer than one record interval" in capsys.readouterr().err
+
+
+def test_a_psins_log_names_its_site(tmp_path, capsys):
+    """PSINS's .imu header holds the site: used when the user gives none, and
+    said; the real log (tests/data) aligns and stays parked there."""
+    from pathlib import Path
+    log = Path(__file__).resolve().parents[1] / "data" / "lasergyro_300s.imu.gz"
+    out = tmp_path / "real"
+    assert cli.main(["replay", str(log), "--coarse", "60", "--reference", "parked", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "site from the log's header: 34.246048 N 108.909664 E 380.0 m" in said
+    s = json.loads((out / "summary.json").read_text())
+    # 240 s of free inertial navigation after a 60 s coarse alignment of a
+    # navigation-grade RLG: metres, not the kilometres of a wrong site or rate
+    # (g eps t^3 / 6 with eps ~ 0.5 deg/h over 240 s is ~50 m)
+    assert s["errors"]["horizontal_max_m"] < 50.0 and s["aligned"]["time_s"] == 60.0

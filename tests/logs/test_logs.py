@@ -416,7 +416,7 @@ def test_project_formats_errors_are_log_errors(tmp_path):
     expect_error(path, "line 2, column 4 (dtheta_z_rad)", "not a number")
     path = tmp_path / "bad.npz"
     np.savez(path, dtheta_p=np.zeros((3, 3)))
-    expect_error(path, "missing arrays")
+    expect_error(path, "no accel array", "the file has dtheta_p")
 
 
 def test_project_formats_are_checked_too(tmp_path):
@@ -519,8 +519,10 @@ def test_no_gravity_needs_plausibility_off(tmp_path):
     ({"dt": -0.01}, "positive"),
     ({"time_col": "none"}, "pass dt"),
     ({"fmt": "binary", "time_col": "last"}, "always start with the time"),
-    ({"fmt": "npz", "kind": "rates"}, "do not apply"),
-    ({"fmt": "csv", "axes": "frd"}, "do not apply"),
+    ({"columns": {"t": "time"}}, "does not apply to text"),
+    ({"fmt": "csv", "columns": {"time": "t"}}, "must map roles"),
+    ({"fmt": "psins", "gyro_unit": "deg"}, "states its units"),
+    ({"gyro_scale": 0.0}, "gyro_scale must be a positive number"),
     ({"fmt": "xls"}, "fmt 'xls'"),
 ])
 def test_bad_options(tmp_path, options, match):
@@ -532,8 +534,8 @@ def test_bad_options(tmp_path, options, match):
 
 
 def test_bad_extension_and_writer_refusals(tmp_path):
-    with pytest.raises(ValueError, match=r"log\.imu: cannot tell the format"):
-        logs.read_log(tmp_path / "log.imu")
+    with pytest.raises(ValueError, match=r"log\.xyz: cannot tell the format"):
+        logs.read_log(tmp_path / "log.xyz")
     data = static_log(n=10, table=True)
     with pytest.raises(ValueError, match="would drop non-zero table angles"):
         logs.write_log(tmp_path / "x.bin", data)

@@ -1,0 +1,217 @@
+"""A replayed log's page and figures: what ``pyins replay`` writes beside
+its records (report.html, attitude.png, alignment.png, errors.png).
+
+Reads only the replay directory (summary.json, navigation.npz), so ``pyins
+report DIR`` re-renders it. What a user replaying a field log needs to see:
+
+1. the attitude over the log, the alignment phases shaded;
+2. the alignment: the fine filter's sigmas (level in arc-seconds, heading in
+   arc-minutes) and its drift estimates; the coarse solution's wander;
+3. the errors against a reference when one was given (the scenario's truth,
+   or ``--reference parked``: the site and zero velocity), north and east
+   apart;
+4. report.html: the aligned attitude, the sigmas and drift estimates at the
+   end of the fine alignment, the integrity figures and fault bits, the
+   warnings, the final state.
+"""
+import html
+import json
+import os
+
+import numpy as np
+
+from pyins.reference import abi
+from pyins.reference.fine_align import EPS, EPS_NU, PHI
+from pyins.report.plotting import pyplot
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UNITS
+
+__all__ = ["render", "is_replay"]
+
+_MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
+          abi.PYINS_MODE_FINE_ALIGN: "fine alignment", abi.PYINS_MODE_NAVIGATE: "navigation"}
+_FAULTS = {v: k[len("PYINS_FAULT_"):] for k, v in vars(abi).items()
+           if k.startswith("PYINS_FAULT_") and isinstance(v, int)}
+#: at most this many points per curve: a 72 h log at 1 Hz has 259,200 records
+MAX_POINTS = 4000
+
+
+def is_replay(summary):
+    """True for the summary.json of ``pyins replay`` (it names its log)."""
+    return "log" in summary and "samples" in summary
+
+
+def _decimate(n):
+    return slice(None, None, max(1, n // MAX_POINTS))
+
+
+def _time_axis(t_s):
+    span = t_s[-1] if len(t_s) else 0.0
+    if span > 3 * UNITS["time"]["h"]:
+        return t_s / UNITS["time"]["h"], "time [h]"
+    if span > 20 * UNITS["time"]["min"]:
+        return t_s / UNITS["time"]["min"], "time [min]"
+    return t_s, "time [s]"
+
+
+def _shade_phases(ax, t, mode):
+    for m, colour in ((abi.PYINS_MODE_COARSE_ALIGN, "0.85"), (abi.PYINS_MODE_FINE_ALIGN, "0.93")):
+        on = np.flatnonzero(mode == m)
+        if len(on):
+            for a in ax:
+                a.axvspan(t[on[0]], t[on[-1]], color=colour, lw=0, zorder=0)
+
+
+def plot_attitude(rec, hz, path):
+    plt = pyplot()
+    k = _decimate(len(rec))
+    t, tl = _time_axis(rec["tick"][k] / hz)
+    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    _shade_phases(ax, t, rec["mode"][k])
+    pitch, roll = np.degrees(rec["euler_b_rad"][k, 0]), np.degrees(rec["euler_b_rad"][k, 1])
+    ax[0].plot(t, pitch, lw=0.8)
+    ax[1].plot(t, roll, lw=0.8)
+    ax[2].plot(t, np.degrees(rec["heading_b_rad"][k]), lw=0.8)
+    for a, yl in zip(ax, ("pitch [deg]", "roll [deg]", "heading [deg]")):
+        a.set_ylabel(yl)
+        a.grid(alpha=0.3)
+    ax[2].set_xlabel(tl)
+    ax[0].set_title("attitude over the log (dark: coarse alignment, light: fine alignment)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_alignment(rec, hz, path):
+    """The fine filter's attitude sigmas over the fine alignment; False when
+    there was none."""
+    fine = rec[rec["mode"] == abi.PYINS_MODE_FINE_ALIGN]
+    if not len(fine):
+        return False
+    plt = pyplot()
+    k = _decimate(len(fine))
+    t, tl = _time_axis(fine["tick"][k] / hz)
+    sig = fine["kf_sigma"][k][:, PHI]
+    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    ax[0].semilogy(t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E")
+    ax[0].semilogy(t, sig[:, 1] / ARCSEC_TO_RAD, label="phi_N")
+    ax[0].set_ylabel("level sigma [arcsec]")
+    ax[0].legend(fontsize=8)
+    ax[1].semilogy(t, sig[:, 2] / ARCMIN_TO_RAD, label="phi_U")
+    ax[1].axhline(10.0, color="k", ls=":", lw=0.8)      # ATT_VALID needs the heading sigma within 10'
+    ax[1].set_ylabel("heading sigma [arcmin]")
+    ax[1].set_xlabel(tl)
+    for a in ax:
+        a.grid(alpha=0.3, which="both")
+    ax[0].set_title("fine alignment: the filter's attitude sigmas (dotted: 10', where the attitude "
+                    "becomes valid)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return True
+
+
+def plot_errors(err, path):
+    """North, east and velocity errors against the reference."""
+    plt = pyplot()
+    k = _decimate(len(err["time_s"]))
+    t, tl = _time_axis(np.asarray(err["time_s"])[k])
+    fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    ax[0].plot(t, np.asarray(err["north_m"])[k], label="north")
+    ax[0].plot(t, np.asarray(err["east_m"])[k], label="east")
+    ax[0].set_ylabel("position error [m]")
+    vel = np.asarray(err["vel_n_mps"])[k]
+    ax[1].plot(t, vel[:, 1], label="north")
+    ax[1].plot(t, vel[:, 0], label="east")
+    ax[1].set_ylabel("velocity error [m/s]")
+    ax[1].set_xlabel(tl)
+    for a in ax:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    ax[0].set_title(f"errors against {err['reference']}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def alignment_figures(rec):
+    """The fine alignment's result at its last record: attitude sigmas and
+    the drift and bias estimates (in the units of seed 001's figures)."""
+    fine = rec[rec["mode"] == abi.PYINS_MODE_FINE_ALIGN]
+    if not len(fine):
+        return None
+    last = fine[-1]
+    out = dict(states=int(last["kf_states"]), time_s=None,
+               sigma_level_arcsec=[float(s / ARCSEC_TO_RAD) for s in last["kf_sigma"][PHI][:2]],
+               sigma_heading_arcmin=float(last["kf_sigma"][PHI][2] / ARCMIN_TO_RAD),
+               nis=float(last["align_nis"]))
+    if last["kf_states"] == 5:
+        # the reduced filter's eps_N^, eps_U^ (seed 001 eq. 21)
+        out["drift_nu_dph"] = [float(x / DPH_TO_RPS) for x in last["kf_x"][EPS_NU][:2]]
+    else:
+        out["drift_enu_dph"] = [float(x / DPH_TO_RPS) for x in last["kf_x"][EPS]]
+    return out
+
+
+def _row(name, value):
+    return f"<tr><th>{html.escape(name)}</th><td>{html.escape(str(value))}</td></tr>"
+
+
+def render(out_dir):
+    """Figures and report.html of a replay directory; returns the page's path."""
+    with open(os.path.join(out_dir, "summary.json")) as f:
+        summary = json.load(f)
+    with np.load(os.path.join(out_dir, "navigation.npz"), allow_pickle=False) as z:
+        rec = z["outputs"]
+    hz = summary.get("rate_hz", 100)
+    figures = []
+    if len(rec):
+        plot_attitude(rec, hz, os.path.join(out_dir, "attitude.png"))
+        figures.append("attitude.png")
+        if plot_alignment(rec, hz, os.path.join(out_dir, "alignment.png")):
+            figures.append("alignment.png")
+    errors_path = os.path.join(out_dir, "errors.npz")
+    if os.path.exists(errors_path):
+        with np.load(errors_path, allow_pickle=False) as z:
+            err = {k: z[k] for k in z.files}
+        err["reference"] = summary.get("errors", {}).get("reference", "the reference")
+        plot_errors(err, os.path.join(out_dir, "errors.png"))
+        figures.append("errors.png")
+
+    rows = [_row("log", summary.get("log")), _row("samples", f"{summary['samples']} at {hz} Hz")]
+    al = summary.get("aligned")
+    if al:
+        rows.append(_row("aligned attitude", f"at {al['time_s']:g} s: pitch {al['pitch_deg']:.4f} deg, "
+                                             f"roll {al['roll_deg']:.4f} deg, heading {al['heading_deg']:.4f} deg"))
+    fa = summary.get("fine_alignment")
+    if fa:
+        lvl = ", ".join(f"{s:.2f}" for s in fa["sigma_level_arcsec"])
+        rows.append(_row("fine alignment at its end",
+                         f"{fa['states']} states; level sigma {lvl} arcsec; heading sigma "
+                         f"{fa['sigma_heading_arcmin']:.2f} arcmin; mean NIS {fa['nis']:.2f} (2 fits)"))
+        if "drift_enu_dph" in fa:
+            rows.append(_row("drift estimate E, N, U [deg/h]", ", ".join(f"{d:.4f}" for d in fa["drift_enu_dph"])))
+        if "drift_nu_dph" in fa:
+            rows.append(_row("drift estimate N, U [deg/h] (reduced filter)",
+                             ", ".join(f"{d:.4f}" for d in fa["drift_nu_dph"])))
+    fin = summary["final"]
+    faults = [n for b, n in sorted(_FAULTS.items()) if b and fin["fault_flags"] & b]
+    rows.append(_row("final", f"{_MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
+                              f"{fin['lon_deg']:.6f} E; faults: {', '.join(faults) or 'none'}"))
+    er = summary.get("errors")
+    if er:
+        rows.append(_row(f"against {er.get('reference', 'the truth')}",
+                         f"max horizontal {er['horizontal_max_m']:.2f} m, final {er['horizontal_final_m']:.2f} m"))
+    warn = "".join(f"<li>{html.escape(w)}</li>" for w in summary.get("warnings", ()))
+    page = ["<!doctype html><html><head><meta charset='utf-8'><title>pyins replay</title>",
+            "<style>body{font-family:sans-serif;max-width:1200px;margin:1em auto}"
+            "table{border-collapse:collapse}th,td{border:1px solid #ccc;padding:4px 8px;text-align:left}"
+            "img{max-width:100%}.warn{color:#a00}</style></head><body>",
+            f"<h1>Replay of {html.escape(os.path.basename(str(summary.get('log'))))}</h1>",
+            f"<ul class='warn'>{warn}</ul>" if warn else "<p>No warnings: the figures below can be trusted "
+            "as far as the firmware can tell.</p>",
+            "<table>", *rows, "</table>",
+            *[f"<p><img src='{f}' alt='{f}'></p>" for f in figures], "</body></html>"]
+    path = os.path.join(out_dir, "report.html")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(page))
+    return path
