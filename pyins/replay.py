@@ -35,10 +35,6 @@ __all__ = ["replay", "replay_config", "warnings", "REFERENCES"]
 #: the references a log's errors can be taken against without a scenario
 REFERENCES = ("parked",)
 
-_FAULT_NAMES = {v: k[len("PYINS_FAULT_"):] for k, v in vars(abi).items()
-                if k.startswith("PYINS_FAULT_") and isinstance(v, int)}
-
-
 def replay_config(spec):
     """The firmware configuration replaying a log of ``spec`` (a RunSpec)
     starts from: its initial state and settings, without indexing (a log's
@@ -72,7 +68,7 @@ def warnings(recs, aligning, hz):
         else:
             why = "it is the configured guess"
         out.append(f"the attitude at the end ({t:g} s) is not valid (ATT_VALID unset): {why}")
-    faults = [name for bit, name in sorted(_FAULT_NAMES.items()) if bit and int(last["fault_flags"]) & bit]
+    faults = abi.fault_names(last["fault_flags"])
     if faults:
         out.append("fault bits set: " + ", ".join(faults))
     return out

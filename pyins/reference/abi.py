@@ -137,3 +137,11 @@ ENUMS = {
 #: Statuses that reject a sample (the state is unchanged but for the fault
 #: bits and counters; a batch stops there).
 SAMPLE_REJECTED = (PYINS_E_SAMPLE_NONFINITE, PYINS_E_SAMPLE_SATURATED)
+
+
+def fault_names(flags):
+    """The names of the PYINS_FAULT_* bits set in ``flags``, without the
+    prefix, lowest bit first (for messages and reports)."""
+    bits = sorted((v, k[len("PYINS_FAULT_"):]) for k, v in globals().items()
+                  if k.startswith("PYINS_FAULT_") and isinstance(v, int) and v)
+    return [name for bit, name in bits if int(flags) & bit]

@@ -5,7 +5,9 @@ Agg backend: files only, no display.
 """
 import math
 
-__all__ = ["pyplot", "margins"]
+from pyins.units import UNITS
+
+__all__ = ["pyplot", "margins", "time_axis"]
 
 
 def pyplot():
@@ -26,3 +28,14 @@ def margins(fig, labels, rot, wspace=0.06):
                if rot else 60.0)
     fig.subplots_adjust(left=min(left / w_px, 0.3), right=0.985, top=0.86,
                         bottom=min(bottom / h_px, 0.5), wspace=wspace)
+
+
+def time_axis(t_s):
+    """Times [s] in the unit that reads best over their span, and its label:
+    hours beyond 3 h, minutes beyond 20 min, else seconds."""
+    span = t_s[-1] if len(t_s) else 0.0
+    if span > 3 * UNITS["time"]["h"]:
+        return t_s / UNITS["time"]["h"], "time [h]"
+    if span > 20 * UNITS["time"]["min"]:
+        return t_s / UNITS["time"]["min"], "time [min]"
+    return t_s, "time [s]"

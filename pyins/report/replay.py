@@ -22,15 +22,13 @@ import numpy as np
 
 from pyins.reference import abi
 from pyins.reference.fine_align import EPS, EPS_NU, PHI
-from pyins.report.plotting import pyplot
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UNITS
+from pyins.report.plotting import pyplot, time_axis
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS
 
 __all__ = ["render", "is_replay"]
 
 _MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
           abi.PYINS_MODE_FINE_ALIGN: "fine alignment", abi.PYINS_MODE_NAVIGATE: "navigation"}
-_FAULTS = {v: k[len("PYINS_FAULT_"):] for k, v in vars(abi).items()
-           if k.startswith("PYINS_FAULT_") and isinstance(v, int)}
 #: at most this many points per curve: a 72 h log at 1 Hz has 259,200 records
 MAX_POINTS = 4000
 
@@ -44,15 +42,6 @@ def _decimate(n):
     return slice(None, None, max(1, n // MAX_POINTS))
 
 
-def _time_axis(t_s):
-    span = t_s[-1] if len(t_s) else 0.0
-    if span > 3 * UNITS["time"]["h"]:
-        return t_s / UNITS["time"]["h"], "time [h]"
-    if span > 20 * UNITS["time"]["min"]:
-        return t_s / UNITS["time"]["min"], "time [min]"
-    return t_s, "time [s]"
-
-
 def _shade_phases(ax, t, mode):
     for m, colour in ((abi.PYINS_MODE_COARSE_ALIGN, "0.85"), (abi.PYINS_MODE_FINE_ALIGN, "0.93")):
         on = np.flatnonzero(mode == m)
@@ -64,7 +53,7 @@ def _shade_phases(ax, t, mode):
 def plot_attitude(rec, hz, path):
     plt = pyplot()
     k = _decimate(len(rec))
-    t, tl = _time_axis(rec["tick"][k] / hz)
+    t, tl = time_axis(rec["tick"][k] / hz)
     fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     _shade_phases(ax, t, rec["mode"][k])
     pitch, roll = np.degrees(rec["euler_b_rad"][k, 0]), np.degrees(rec["euler_b_rad"][k, 1])
@@ -89,7 +78,7 @@ def plot_alignment(rec, hz, path):
         return False
     plt = pyplot()
     k = _decimate(len(fine))
-    t, tl = _time_axis(fine["tick"][k] / hz)
+    t, tl = time_axis(fine["tick"][k] / hz)
     sig = fine["kf_sigma"][k][:, PHI]
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     ax[0].semilogy(t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E")
@@ -114,7 +103,7 @@ def plot_errors(err, path):
     """North, east and velocity errors against the reference."""
     plt = pyplot()
     k = _decimate(len(err["time_s"]))
-    t, tl = _time_axis(np.asarray(err["time_s"])[k])
+    t, tl = time_axis(np.asarray(err["time_s"])[k])
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     ax[0].plot(t, np.asarray(err["north_m"])[k], label="north")
     ax[0].plot(t, np.asarray(err["east_m"])[k], label="east")
@@ -194,7 +183,7 @@ def render(out_dir):
             rows.append(_row("drift estimate N, U [deg/h] (reduced filter)",
                              ", ".join(f"{d:.4f}" for d in fa["drift_nu_dph"])))
     fin = summary["final"]
-    faults = [n for b, n in sorted(_FAULTS.items()) if b and fin["fault_flags"] & b]
+    faults = abi.fault_names(fin["fault_flags"])
     rows.append(_row("final", f"{_MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
                               f"{fin['lon_deg']:.6f} E; faults: {', '.join(faults) or 'none'}"))
     er = summary.get("errors")

@@ -22,12 +22,10 @@ import numpy as np
 
 from pyins import metrics, records, runs
 from pyins.metrics import FIGURE_METRICS, display
-from pyins.report.plotting import pyplot
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, UNITS
+from pyins.report.plotting import pyplot, time_axis
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
 
 __all__ = ["render", "load", "plot_errors", "plot_alignment", "plot_table", "plot_comparison"]
-
-_MIN, _HOUR = UNITS["time"]["min"], UNITS["time"]["h"]
 
 
 def load(run_dir):
@@ -71,19 +69,13 @@ def load(run_dir):
     return summary, series
 
 
-def _time_axis(t_s):
-    span = t_s[-1] if len(t_s) else 0.0
-    return (t_s / _HOUR, "time [h]") if span > 3 * _HOUR else (
-        (t_s / _MIN, "time [min]") if span > 20 * _MIN else (t_s, "time [s]"))
-
-
 def plot_errors(summary, series, path):
     plt = pyplot()
     big = max((s["horizontal_m"].max() for s in series.values() if len(s["horizontal_m"])), default=0)
     pos_scale, pos_unit = (NMI_TO_M, "nmi") if big > 0.5 * NMI_TO_M else (1.0, "m")
     fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
     for label, s in series.items():
-        t, tl = _time_axis(s["time_s"])
+        t, tl = time_axis(s["time_s"])
         ax[0].plot(t, s["horizontal_m"] / pos_scale, label=label)
         ax[1].plot(t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, label=label)
         ax[2].plot(t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, label=label)
@@ -111,7 +103,7 @@ def plot_alignment(summary, series, path):
     names = ["phi_E [arcsec]", "phi_N [arcsec]", "phi_U [arcmin]"]
     scale = [ARCSEC_TO_RAD, ARCSEC_TO_RAD, ARCMIN_TO_RAD]
     for label, s in aligning.items():
-        t, tl = _time_axis(s["time_s"])
+        t, tl = time_axis(s["time_s"])
         for i in range(3):
             # |error| on a log axis: the first seconds are degrees, the end arc-seconds
             ax[i].semilogy(t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9)
@@ -141,7 +133,7 @@ def plot_table(summary, series, path):
     fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     for label, s in turning.items():
         o = s["outputs"]
-        t, tl = _time_axis(s["time_s"])
+        t, tl = time_axis(s["time_s"])
         ax[0].plot(t, np.degrees(o["table_angle_rad"]), label=label, lw=0.8)
         ax[1].plot(t, np.degrees(o["yaw_p_rad"]), label=label, lw=0.5)
         ax[2].plot(t, o["index_a_c"], label=f"{label}: A_c", lw=0.8)
