@@ -24,11 +24,11 @@ import numpy as np
 
 from pyins import engine as engines
 from pyins import metrics, native, runner, scenario, sim
-from pyins.reference import abi, earth
+from pyins.reference import abi
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ, TWO_PI
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
 
 __all__ = ["replay", "replay_config", "warnings", "REFERENCES"]
 
@@ -76,13 +76,12 @@ def warnings(recs, aligning, hz):
 
 def _parked_errors(recs, cfg, hz):
     """Errors against the configured site and zero velocity (a parked
-    vehicle): north and east position [m] on the site's radii (Qin (2014)
-    eq. 4.1.7), the velocity in n [m/s]."""
-    lat0, lon0, h0 = cfg["lat_rad"], cfg["lon_rad"], cfg.get("height_m", 0.0)
-    rm, rn = earth.principal_radii(np.sin(lat0))
-    north = (recs["lat_rad"] - lat0) * (rm + h0)
-    east = (np.mod(recs["lon_rad"] - lon0 + np.pi, TWO_PI) - np.pi) * (rn + h0) * np.cos(lat0)
-    return dict(time_s=recs["tick"] / hz, north_m=north, east_m=east, vel_n_mps=recs["vel_n_mps"].copy())
+    vehicle): `pyins.metrics.nav_errors` against a static truth at the site
+    (its attitude errors mean nothing here and are not kept)."""
+    site = sim.Static(cfg["lat_rad"], cfg["lon_rad"], cfg.get("height_m", 0.0))
+    dt = 1.0 / hz
+    e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=sim.truth_at(site, recs["tick"], dt=dt), dt=dt))
+    return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
 
 
 def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None):
