@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 9
+#define PYINS_ABI_VERSION_MINOR 10
 
 #ifdef __cplusplus
 extern "C" {
@@ -66,7 +66,7 @@ enum pyins_status {
     PYINS_E_CONFIG_ALIGN_EARLY = -18, /* first coarse output before enough data: ratio * first < every */
     PYINS_E_CONFIG_ALIGN_LONG = -19,  /* TRIAD coarse alignment longer than its fixed storage allows (FIT: no limit) */
     PYINS_E_CONFIG_ALIGN_TICKS = -20, /* an alignment duration negative, or first output after its end */
-    PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5, 8 or 12, negative update interval, unknown correction */
+    PYINS_E_CONFIG_FINE = -21,        /* fine_states not 5, 8 or 12, negative update interval, unknown correction or noise source */
     PYINS_E_CONFIG_NOISE = -22,       /* a noise density or initial sigma negative or not finite */
     PYINS_E_CONFIG_INDEX_SCHEME = -23, /* unknown indexing scheme */
     PYINS_E_CONFIG_INDEX_EMPTY = -24, /* custom scheme with no steps (or more than 8) */
@@ -142,6 +142,16 @@ enum pyins_coarse_method {
 enum pyins_fine_correction {
     PYINS_FINE_FEEDBACK = 0,      /* correct the attitude after every update (seed 001's advice) */
     PYINS_FINE_OPEN_LOOP = 1      /* leave it; report the corrected attitude */
+};
+
+/* Where the static fine filters' measurement noise R comes from
+ * (pyins_config.fine_noise). */
+enum pyins_fine_noise {
+    PYINS_FINE_NOISE_MEASURED = 0,   /* the larger of fine_accel_vrw and the horizontal specific-force noise
+                                        the coarse phase measured on the update interval (pyins_output.
+                                        coarse_vrw; sensor noise plus vibration); fine_accel_vrw without a
+                                        coarse phase (docs/core.md, "Measurement noise") */
+    PYINS_FINE_NOISE_CONFIGURED = 1  /* fine_accel_vrw as configured */
 };
 
 /* Bits of pyins_output.fault_flags (sticky: set once, never cleared). */
@@ -256,7 +266,7 @@ typedef struct pyins_config {
     int32_t reserved2;            /* padding, ignored; keep 0 */
     /* Integrity tests of the alignment (docs/concepts.md, "Integrity"). */
     int32_t integrity_nis_window; /* fine-alignment updates per NIS window; 0 = 100, -1 = no test */
-    int32_t reserved3;            /* padding, ignored; keep 0 */
+    int32_t fine_noise;           /* enum pyins_fine_noise; 0 = MEASURED */
     double integrity_nis_max;     /* bound on a window's mean NIS (2 when the model holds); 0 = 4 */
     double integrity_coarse_rad;  /* bound on the coarse solution's wander over its last fifth [rad];
                                      0 = 30 arcmin */
@@ -319,6 +329,11 @@ typedef struct pyins_output {
     double coarse_wander_rad;     /* sine of the largest rotation of the coarse solution from its
                                      value at the start of the coarse alignment's last fifth
                                      (1 for 90 deg or more) */
+    double coarse_vrw;            /* horizontal specific-force noise density the coarse phase measured on the
+                                     fine alignment's update interval [(m/s)/sqrt(s)]; 0 before 5 s of it,
+                                     or when no static fine alignment follows or fine_noise is CONFIGURED */
+    double fine_vrw;              /* the noise density the static fine filter's R is built from
+                                     [(m/s)/sqrt(s)] (fine_noise); 0 before it starts and for fine_states 12 */
 } pyins_output;
 
 /* The firmware instance. Opaque: it lives in caller memory of

@@ -177,6 +177,20 @@ void init(CoarseAlign& a, const Params& prm) {
     a.settling = false;
     a.settle_ref = Mat3::Identity();
     a.wander = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        a.noise_v[i] = Vec3::Zero();
+    }
+    a.noise_seen = 0;
+    a.noise_sum = 0.0;
+    a.noise_n = 0;
+}
+
+double measured_vrw(const CoarseAlign& a) {
+    if (a.noise_n < kNoiseMinSamples) {
+        return 0.0;
+    }
+    const double tau = static_cast<double>(a.prm.noise_every) * a.prm.dt;
+    return pmath::sqrt(tau / 6.0 * (a.noise_sum / static_cast<double>(a.noise_n)) / 2.0);
 }
 
 namespace {
@@ -195,6 +209,26 @@ void settle(CoarseAlign& a) {
     if (s > a.wander) {
         a.wander = s;
     }
+}
+
+/// One block end of the noise measurement (see the header): v, the
+/// reference point's v^ib0 now.
+void measure_noise(CoarseAlign& a, const Vec3& v) {
+    if (a.noise_seen == 3) {
+        const double tau = static_cast<double>(a.prm.noise_every) * a.prm.dt;
+        const Vec3 d = (v - 3.0 * a.noise_v[0] + 3.0 * a.noise_v[1] - a.noise_v[2]) / tau;
+        const double vv = v.dot(v);
+        if (vv > 0.0) {
+            const double up = d.dot(v);
+            a.noise_sum = a.noise_sum + (d.dot(d) - up * up / vv);
+            a.noise_n = a.noise_n + 1;
+        }
+    } else {
+        a.noise_seen = a.noise_seen + 1;
+    }
+    a.noise_v[2] = a.noise_v[1];
+    a.noise_v[1] = a.noise_v[0];
+    a.noise_v[0] = v;
 }
 
 }  // namespace
@@ -219,6 +253,9 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
             // not need it.
             a.lever_vel0 = lever_vel_p;
         }
+    }
+    if (a.prm.noise_every > 0 && a.tick % a.prm.noise_every == 0) {
+        measure_noise(a, vel);
     }
     const bool fit = a.prm.method == static_cast<int32_t>(Method::kFit);
     if (fit) {

@@ -65,6 +65,23 @@
 // has ended and passed this test. On a moored ship TRIAD moves by tens of
 // arc-minutes over that fifth (164-326' with seed 000's errors), FIT by
 // < 1.5' over 300 s and up to 11' over 120 s (its noise then).
+//
+// Noise (for the fine alignment's R). The fine alignment that follows
+// measures the specific force averaged over tau = noise_every ticks; its R
+// must be the variance of that mean, which on a real site is the sensor
+// noise plus vibration (the PSINS laser-gyro log of a parked vehicle:
+// ~800 ug/sqrt(Hz) at tau = 0.1 s against a 10 ug/sqrt(Hz) default). The
+// coarse phase measures it on the same interval: m_k, the reference point's
+// mean specific force in ib0 over block k (attitude motion removed by
+// C_p^ib0, the lever velocity removed as above), and its second difference
+// d_k = m_k - 2 m_(k-1) + m_(k-2) = (V_k - 3 V_(k-1) + 3 V_(k-2) - V_(k-3)) / tau
+// (V: v^ib0 at the block ends), which cancels any trend linear over 3 tau
+// (the Earth's rotation of gravity in ib0, a bias drift, a wave's slow
+// acceleration: 0.1 m/s^2 at 0.1 Hz leaves 2 % of the variance of 10 ug/sqrt(Hz)).
+// For white noise of density q, Var(d) = 6 q^2 / tau per axis; of the two
+// horizontal axes (d less its component along v^ib0, the direction of the
+// mean specific force, i.e. up):
+//   q^2 = tau / 6 * mean(|d_h|^2) / 2.
 #pragma once
 
 #include <cstdint>
@@ -98,7 +115,12 @@ struct Params {
     double cos_lat;
     double gravity;          ///< normal gravity at the site [m/s^2]
     int64_t settle_from;     ///< first tick of the wander test
+    int32_t noise_every;     ///< ticks per block of the noise measurement (tau); 0: none
 };
+
+/// Second differences needed before measured_vrw reports a value (5 s at
+/// 10 blocks per second: the estimate's relative sigma is then ~15 %).
+inline constexpr int64_t kNoiseMinSamples = 50;
 
 struct CoarseAlign {
     Params prm;
@@ -117,6 +139,10 @@ struct CoarseAlign {
     bool settling;           ///< settle_ref holds the first solution of the wander test
     Mat3 settle_ref;         ///< that solution
     double wander;           ///< sine of the largest rotation from it since (0 before)
+    Vec3 noise_v[3];         ///< V at the last three block ends, newest first
+    int32_t noise_seen;      ///< block ends seen (capped at 3)
+    double noise_sum;        ///< sum of |d_h|^2 [(m/s^2)^2]
+    int64_t noise_n;         ///< second differences in it
 };
 
 /// Sine of the rotation angle between two rotation matrices (1 beyond 90 deg).
@@ -147,6 +173,10 @@ Mat3 mat_n_e(double sin_lat, double cos_lat);
 
 /// C_i^e(t) = Rz(w t)^T: the Earth's rotation since t0 (eq. 2).
 Mat3 mat_e_i(double t);
+
+/// The horizontal specific-force noise density measured so far (see the
+/// header) [(m/s)/sqrt(s)]; 0 before kNoiseMinSamples second differences.
+double measured_vrw(const CoarseAlign& a);
 
 /// Start an alignment. Precondition: parameters checked by the firmware.
 void init(CoarseAlign& a, const Params& prm);

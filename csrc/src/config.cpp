@@ -213,7 +213,8 @@ int config_check(const pyins_config& raw) {
     }
     if ((cfg.fine_states != 5 && cfg.fine_states != 8 && cfg.fine_states != 12) ||
         cfg.fine_meas_every_ticks < 0 ||
-        (cfg.fine_correction != PYINS_FINE_FEEDBACK && cfg.fine_correction != PYINS_FINE_OPEN_LOOP)) {
+        (cfg.fine_correction != PYINS_FINE_FEEDBACK && cfg.fine_correction != PYINS_FINE_OPEN_LOOP) ||
+        (cfg.fine_noise != PYINS_FINE_NOISE_MEASURED && cfg.fine_noise != PYINS_FINE_NOISE_CONFIGURED)) {
         return PYINS_E_CONFIG_FINE;
     }
     const double noise[9] = {cfg.fine_gyro_arw, cfg.fine_accel_vrw, cfg.fine_sigma0_att_rad[0],

@@ -74,6 +74,7 @@ void Firmware::init(const pyins_config& raw) {
     lever_vel_n_ = Vec3::Zero();
     lever_refine_ = 0;
     integrity_lost_ = 0;
+    fine_vrw_ = 0.0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
     coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 
@@ -103,6 +104,11 @@ void Firmware::init(const pyins_config& raw) {
         pmath::sincos(cfg.lat_rad, &prm.sin_lat, &prm.cos_lat);
         prm.gravity = earth::normal_gravity(prm.sin_lat, cfg.height_m);
         prm.settle_from = cfg.coarse_ticks - cfg.coarse_ticks / 5;
+        // the noise the static fine filters' R is built from, measured on
+        // their update interval (coarse_align.hpp, "Noise")
+        const bool static_fine = cfg.fine_ticks > 0 && cfg.fine_states != 12;
+        prm.noise_every = static_fine && cfg.fine_noise == PYINS_FINE_NOISE_MEASURED
+                              ? cfg.fine_meas_every_ticks : 0;
         coarse_align::init(coarse_, prm);
     }
     indexing::Params& ip = index_prm_;
@@ -308,6 +314,15 @@ void Firmware::start_fine() {
     prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
     prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
+    if (cfg_.coarse_ticks > 0 && cfg_.fine_states != 12) {
+        // R from the noise the coarse phase measured when it is larger than
+        // the configured density (fine_noise MEASURED; coarse_align.hpp)
+        const double measured = coarse_align::measured_vrw(coarse_);
+        if (measured > prm.accel_vrw) {
+            prm.accel_vrw = measured;
+        }
+    }
+    fine_vrw_ = prm.accel_vrw;
     if (cfg_.coarse_ticks > 0) {
         // capped at the default (copied: the inline table's address is not taken)
         const double cap[3] = {config::kDefaultFineSigmaAtt[0], config::kDefaultFineSigmaAtt[1],
@@ -793,6 +808,8 @@ void Firmware::output(pyins_output* out) const {
     out->align_nis = kf_states_ == 12 ? moving_.nis_mean
                      : (kf_states_ == 8 ? fine8_.nis_mean : (kf_states_ == 5 ? fine5_.nis_mean : 0.0));
     out->coarse_wander_rad = cfg_.coarse_ticks > 0 ? coarse_.wander : 0.0;
+    out->coarse_vrw = cfg_.coarse_ticks > 0 ? coarse_align::measured_vrw(coarse_) : 0.0;
+    out->fine_vrw = kf_states_ == 5 || kf_states_ == 8 ? fine_vrw_ : 0.0;
     out->kf_states = kf_states_;
     out->align_restarts = align_restarts_;
     for (int i = 0; i < 8; ++i) {

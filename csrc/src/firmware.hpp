@@ -176,6 +176,7 @@ class Firmware {
     int32_t lever_refine_;        ///< 1: navigation started from the configured state last tick
     int32_t integrity_lost_;      ///< 1: an integrity test failed: the attitude is never valid again
     double coarse_wander_max_;    ///< sine of integrity_coarse_rad
+    double fine_vrw_;             ///< accelerometer noise density of the static fine filter's R [(m/s)/sqrt(s)]
 };
 
 }  // namespace pyins::firmware

@@ -82,6 +82,10 @@ PYINS_COARSE_FIT = 1
 PYINS_FINE_FEEDBACK = 0
 PYINS_FINE_OPEN_LOOP = 1
 
+# --- enum pyins_fine_noise --------------------------------------------------
+PYINS_FINE_NOISE_MEASURED = 0
+PYINS_FINE_NOISE_CONFIGURED = 1
+
 # --- enum pyins_fault_flag: sticky bits of pyins_output.fault_flags ---------
 PYINS_FAULT_KF_NOT_PD = 1
 PYINS_FAULT_ALIGN_RESTARTED = 2
@@ -126,6 +130,7 @@ ENUMS = {
                                "PYINS_INDEX_FAULT"]),
         ("pyins_coarse_method", ["PYINS_COARSE_TRIAD", "PYINS_COARSE_FIT"]),
         ("pyins_fine_correction", ["PYINS_FINE_FEEDBACK", "PYINS_FINE_OPEN_LOOP"]),
+        ("pyins_fine_noise", ["PYINS_FINE_NOISE_MEASURED", "PYINS_FINE_NOISE_CONFIGURED"]),
         ("pyins_fault_flag", [n for n in dir() if n.startswith("PYINS_FAULT_")]),
         ("pyins_seq_mode", ["PYINS_SEQ_OFF", "PYINS_SEQ_CHECK"]),
         ("pyins_mode", [n for n in dir() if n.startswith("PYINS_MODE_")]),

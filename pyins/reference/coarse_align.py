@@ -4,6 +4,7 @@ Mirrors ``csrc/src/coarse_align.{hpp,cpp}``; the header explains the method,
 the sign of eq. 5, the TRIAD construction that replaces eq. 8, the lever-arm
 velocity it removes and the moving-base method FIT.
 """
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,6 +30,10 @@ class Params:
     cos_lat: float
     gravity: float
     settle_from: int = 0
+    noise_every: int = 0
+
+
+NOISE_MIN_SAMPLES = 50   #: kNoiseMinSamples
 
 
 @dataclass
@@ -48,6 +53,10 @@ class CoarseAlign:
     settling: bool = False
     settle_ref: np.ndarray = field(default_factory=lambda: np.eye(3))
     wander: float = 0.0
+    noise_v: list = field(default_factory=lambda: [np.zeros(3), np.zeros(3), np.zeros(3)])
+    noise_seen: int = 0
+    noise_sum: float = 0.0
+    noise_n: int = 0
 
 
 def vel_i(t, sin_lat, cos_lat, gravity):
@@ -162,6 +171,15 @@ def init(prm):
     return CoarseAlign(prm=prm)
 
 
+def measured_vrw(a):
+    """The horizontal specific-force noise density measured so far
+    [(m/s)/sqrt(s)]; 0 before NOISE_MIN_SAMPLES (mirrors measured_vrw)."""
+    if a.noise_n < NOISE_MIN_SAMPLES:
+        return 0.0
+    tau = float(a.prm.noise_every) * a.prm.dt
+    return math.sqrt(tau / 6.0 * (a.noise_sum / float(a.noise_n)) / 2.0)
+
+
 def settle(a):
     """The wander test on a new solution (mirrors settle)."""
     if a.tick < a.prm.settle_from:
@@ -173,6 +191,22 @@ def settle(a):
     s = rotation_sine(a.settle_ref, a.mat_i_ib0)
     if s > a.wander:
         a.wander = s
+
+
+def measure_noise(a, v):
+    """One block end of the noise measurement (mirrors measure_noise): the
+    second difference of the block means of the specific force, horizontal."""
+    if a.noise_seen == 3:
+        tau = float(a.prm.noise_every) * a.prm.dt
+        d = (v - 3.0 * a.noise_v[0] + 3.0 * a.noise_v[1] - a.noise_v[2]) / tau
+        vv = float(v @ v)
+        if vv > 0.0:
+            up = float(d @ v)
+            a.noise_sum = a.noise_sum + (float(d @ d) - up * up / vv)
+            a.noise_n = a.noise_n + 1
+    else:
+        a.noise_seen = a.noise_seen + 1
+    a.noise_v = [np.array(v, dtype=float), a.noise_v[0], a.noise_v[1]]
 
 
 def update(a, dtheta_p, dv_p, lever_vel_p=None):
@@ -192,6 +226,8 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
         vel = vel - attitude.quat_to_mat(a.quat_ib0_p) @ lever_vel_p
         if a.tick == 1:
             a.lever_vel0 = np.array(lever_vel_p, dtype=float)
+    if a.prm.noise_every > 0 and a.tick % a.prm.noise_every == 0:
+        measure_noise(a, vel)
     fit = a.prm.method == METHOD_FIT
     if fit:
         a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel)

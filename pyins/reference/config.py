@@ -104,7 +104,7 @@ def config_default():
         "coarse_method": abi.PYINS_COARSE_TRIAD,
         "reserved2": 0,
         "integrity_nis_window": 0,
-        "reserved3": 0,
+        "fine_noise": abi.PYINS_FINE_NOISE_MEASURED,
         "integrity_nis_max": 0.0,
         "integrity_coarse_rad": 0.0,
         "fine_pos_sigma_m": 0.0,
@@ -251,7 +251,8 @@ def config_check(raw):
     if cfg["fine_ticks"] < 0:
         return abi.PYINS_E_CONFIG_ALIGN_TICKS
     if (cfg["fine_states"] not in (5, 8, 12) or cfg["fine_meas_every_ticks"] < 0
-            or cfg["fine_correction"] not in (abi.PYINS_FINE_FEEDBACK, abi.PYINS_FINE_OPEN_LOOP)):
+            or cfg["fine_correction"] not in (abi.PYINS_FINE_FEEDBACK, abi.PYINS_FINE_OPEN_LOOP)
+            or cfg["fine_noise"] not in (abi.PYINS_FINE_NOISE_MEASURED, abi.PYINS_FINE_NOISE_CONFIGURED)):
         return abi.PYINS_E_CONFIG_FINE
     noise = [cfg["fine_gyro_arw"], cfg["fine_accel_vrw"], *cfg["fine_sigma0_att_rad"],
              cfg["fine_sigma0_gyro"], cfg["fine_sigma0_accel"], cfg["fine_pos_sigma_m"],

@@ -97,6 +97,7 @@ class Firmware:
         self.lever_vel_n = np.zeros(3)
         self.lever_refine = 0
         self.integrity_lost = 0
+        self.fine_vrw = 0.0
         wander = cfg["integrity_coarse_rad"]
         self.coarse_wander_max = 1.0 if wander >= 0.5 * np.pi else math.sin(wander)
         euler_b = np.array(cfg["euler_b_rad"], dtype=float)
@@ -127,7 +128,10 @@ class Firmware:
                 method=cfg["coarse_method"], lever=self.has_lever, ratio=cfg["coarse_ratio"], first_output=cfg["coarse_first_output_ticks"],
                 output_every=cfg["coarse_output_every_ticks"], dt=self.dt, sin_lat=sin_lat,
                 cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
-                settle_from=cfg["coarse_ticks"] - cfg["coarse_ticks"] // 5)
+                settle_from=cfg["coarse_ticks"] - cfg["coarse_ticks"] // 5,
+                # the noise of the static fine filters' R (coarse_align, "Noise")
+                noise_every=(cfg["fine_meas_every_ticks"] if cfg["fine_ticks"] > 0 and cfg["fine_states"] != 12
+                             and cfg["fine_noise"] == abi.PYINS_FINE_NOISE_MEASURED else 0))
             self.coarse = coarse_align.init(prm)
 
     def start_navigation(self):
@@ -258,6 +262,12 @@ class Firmware:
             accel_vrw=cfg["fine_accel_vrw"], sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
             nis_window=max(cfg["integrity_nis_window"], 0), nis_max=cfg["integrity_nis_max"])
+        if cfg["coarse_ticks"] > 0 and cfg["fine_states"] != 12:
+            # R from the coarse phase's measured noise when larger (fine_noise MEASURED)
+            measured = coarse_align.measured_vrw(self.coarse)
+            if measured > prm.accel_vrw:
+                prm.accel_vrw = measured
+        self.fine_vrw = prm.accel_vrw
         if cfg["coarse_ticks"] > 0:
             fine_align.sigma0_after_coarse(prm, float(cfg["coarse_ticks"]) * self.dt, self.coarse.wander,
                                            config.DEFAULT_FINE_SIGMA_ATT)
@@ -569,6 +579,8 @@ class Firmware:
             "seq": self.seq,
             "align_nis": self.fine.nis_mean if self.fine is not None else 0.0,
             "coarse_wander_rad": self.coarse.wander if self.cfg["coarse_ticks"] > 0 else 0.0,
+            "coarse_vrw": coarse_align.measured_vrw(self.coarse) if self.cfg["coarse_ticks"] > 0 else 0.0,
+            "fine_vrw": self.fine_vrw if self.kf_states in (5, 8) else 0.0,
             "kf_x": self._kf(lambda f: f.x),
             "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
         }

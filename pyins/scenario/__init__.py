@@ -56,8 +56,8 @@ from pyins.scenario.build import (RunSpec, _build_motion, _firmware_check, _firm
                                   initial_config, initial_errors, initial_truth)
 from pyins.scenario.resolve import (_ALTERNATIVES, _NOT_COMPARABLE, _check_key_path, _resolve,
                                     _resolve_paper, _set_key)
-from pyins.scenario.schema import (COARSE_METHODS, COMPARE_KEYS, COMPONENT_KEYS, FINE_CORRECTIONS, FIGURE_KEYS, INDEX_SCHEMES, INDEX_SUMS,
-                                   METRICS, MOTION_COMMON, MOTION_KINDS, SCHEMA_VERSION, SEGMENT_KEYS,
+from pyins.scenario.schema import (COARSE_METHODS, COMPARE_KEYS, COMPONENT_KEYS, FINE_CORRECTIONS,
+                                   FINE_NOISES, FIGURE_KEYS, INDEX_SCHEMES, INDEX_SUMS, METRICS, MOTION_COMMON, MOTION_KINDS, SCHEMA_VERSION, SEGMENT_KEYS,
                                    SHIP_KEYS, SPECTRUM_KEYS, STEP_KEYS, TABLES, TOP_KEYS, VERTICAL_MODES,
                                    Key)
 from pyins.scenario.values import _need_table, _read

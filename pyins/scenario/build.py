@@ -13,7 +13,7 @@ import numpy as np
 
 from pyins import limits, native, sim
 from pyins.reference import attitude, earth
-from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, INDEX_SUMS, VERTICAL_MODES,
+from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, FINE_NOISES, INDEX_SUMS, VERTICAL_MODES,
                                    _LINEAR_AXES, _STEP_MOVES, _TABLE_FAULTS)
 from pyins.sim import turntable
 from pyins.units import DT, TICK_HZ, ScenarioError
@@ -183,6 +183,8 @@ def _firmware_config(res, motion):
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
         cfg["fine_correction"] = FINE_CORRECTIONS[fw["fine_correction"]]
+    if fw.get("fine_noise") is not None:
+        cfg["fine_noise"] = FINE_NOISES[fw["fine_noise"]]
     if fw.get("coarse_method") is not None:
         cfg["coarse_method"] = COARSE_METHODS[fw["coarse_method"]]
     if fw.get("lever") == "unknown":

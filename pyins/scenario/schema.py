@@ -228,6 +228,7 @@ STEP_KEYS = {
 #: the firmware's enums by the names scenario files and the CLI use
 VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
 FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
+FINE_NOISES = {"measured": abi.PYINS_FINE_NOISE_MEASURED, "configured": abi.PYINS_FINE_NOISE_CONFIGURED}
 COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT}
 FIRMWARE_KEYS = {
     "initial_attitude": Key("choice", "attitude the firmware starts from: the true one (plus "
@@ -262,6 +263,10 @@ FIRMWARE_KEYS = {
     "fine_accel_vrw": Key("velocity_random_walk", "filter R: accelerometer VRW (firmware default "
                                                   "10 ug/sqrt(Hz))", lo="0 ug/sqrt(Hz)",
                           hi="10 mg/sqrt(Hz)", lo_open=True),
+    "fine_noise": Key("choice", "where the static fine filters' R comes from: 'measured' (the larger of "
+                                "fine_accel_vrw and the noise the coarse phase measured, vibration "
+                                "included) or 'configured' (fine_accel_vrw alone; firmware default "
+                                "measured)", choices=tuple(FINE_NOISES)),
     "fine_sigma0_att": _angle("initial sigma of phi E, N, U (firmware default: fitted to the coarse "
                               "result after a coarse alignment, else 100', 100', 600'; 1', 1', 10' "
                               "for the moving-base filter)",

@@ -204,7 +204,7 @@ static const field kFields[] = {
     FLD(index_jump_rad, T_F64), FLD(seq_mode, T_I32), FLD(seq_max_gap_ticks, T_I32),
     FLD(sat_gyro_rad, T_F64), FLD(sat_accel_mps, T_F64), FLD(index_sums, T_I32), FLD(reserved1, T_I32),
     FLD(lever_b_m, T_F64), FLD(lever_p_m, T_F64), FLD(coarse_method, T_I32), FLD(reserved2, T_I32),
-    FLD(integrity_nis_window, T_I32), FLD(reserved3, T_I32), FLD(integrity_nis_max, T_F64),
+    FLD(integrity_nis_window, T_I32), FLD(fine_noise, T_I32), FLD(integrity_nis_max, T_F64),
     FLD(integrity_coarse_rad, T_F64), FLD(fine_pos_sigma_m, T_F64), FLD(fine_sigma0_vel_mps, T_F64),
 };
 #undef FLD
@@ -473,6 +473,9 @@ static void check_output(const pyins_output *o) {
             "output kf_states");
     REQUIRE(!(o->coarse_wander_rad < 0.0) && !(o->coarse_wander_rad > 1.0 + 1e-12), "coarse_wander_rad in [0, 1]");
     REQUIRE(!(o->align_nis < 0.0), "align_nis >= 0");
+    /* from finite samples below saturation and a checked fine_accel_vrw: finite, >= 0 */
+    REQUIRE(o->coarse_vrw >= 0.0 && o->coarse_vrw < 1e300, "coarse_vrw finite and >= 0");
+    REQUIRE(o->fine_vrw >= 0.0 && o->fine_vrw < 1e300, "fine_vrw finite and >= 0");
     REQUIRE(o->index_state >= PYINS_INDEX_IDLE && o->index_state <= PYINS_INDEX_FAULT, "output index_state");
     REQUIRE(o->index_fault >= 0 && o->index_fault <= 3, "output index_fault");
     REQUIRE(o->index_step >= 0 && o->index_step < 8, "output index_step");

@@ -19,7 +19,7 @@ def static_samples(n, lat=0.5):
 def test_layout_matches_library():
     assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 64
     assert native.SAMPLE_DTYPE.fields["seq"][1] == 56
-    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 416   # + align_nis, coarse_wander_rad (ABI 0.9)
+    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 432   # + coarse_vrw, fine_vrw (ABI 0.10)
     assert native.OUTPUT_DTYPE.itemsize % 8 == 0
     assert native.abi_version() == native.EXPECTED_ABI
     assert native.version() == "0.1.0"
