@@ -23,7 +23,7 @@ import numpy as np
 from pyins.reference import abi
 from pyins.reference.fine_align import EPS, EPS_NU, PHI
 from pyins.report.plotting import pyplot, time_axis
-from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS
+from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
 
 __all__ = ["render", "is_replay"]
 
@@ -133,6 +133,11 @@ def alignment_figures(rec):
                sigma_level_arcsec=[float(s / ARCSEC_TO_RAD) for s in last["kf_sigma"][PHI][:2]],
                sigma_heading_arcmin=float(last["kf_sigma"][PHI][2] / ARCMIN_TO_RAD),
                nis=float(last["align_nis"]))
+    if last["kf_states"] in (5, 8):
+        # the noise density R is built from, and what the coarse phase measured
+        # (0: nothing measured; docs/core.md, "Measurement noise of the fine alignment")
+        out["r_vrw_ug_sqrt_hz"] = float(last["fine_vrw"] / UG_TO_MPS2)
+        out["measured_vrw_ug_sqrt_hz"] = float(last["coarse_vrw"] / UG_TO_MPS2)
     if last["kf_states"] == 5:
         # the reduced filter's eps_N^, eps_U^ (seed 001 eq. 21)
         out["drift_nu_dph"] = [float(x / DPH_TO_RPS) for x in last["kf_x"][EPS_NU][:2]]
@@ -177,6 +182,12 @@ def render(out_dir):
         rows.append(_row("fine alignment at its end",
                          f"{fa['states']} states; level sigma {lvl} arcsec; heading sigma "
                          f"{fa['sigma_heading_arcmin']:.2f} arcmin; mean NIS {fa['nis']:.2f} (2 fits)"))
+        if "r_vrw_ug_sqrt_hz" in fa:
+            measured = fa["measured_vrw_ug_sqrt_hz"]
+            source = ("the noise the coarse phase measured (vibration included)"
+                      if measured > 0.0 and fa["r_vrw_ug_sqrt_hz"] == measured
+                      else "the configured density" + (f" (measured {measured:.1f}, below it)" if measured > 0.0 else ""))
+            rows.append(_row("measurement noise R", f"{fa['r_vrw_ug_sqrt_hz']:.1f} ug/sqrt(Hz): {source}"))
         if "drift_enu_dph" in fa:
             rows.append(_row("drift estimate E, N, U [deg/h]", ", ".join(f"{d:.4f}" for d in fa["drift_enu_dph"])))
         if "drift_nu_dph" in fa:

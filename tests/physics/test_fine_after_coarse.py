@@ -176,3 +176,7 @@ def test_the_real_log_keeps_its_coarse_heading(tmp_path):
     assert 0.5 < out["align_nis"][fine[-1]] < 4.0
     assert not out["fault_flags"][-1] & abi.PYINS_FAULT_ALIGN_INCONSISTENT
     assert "aligned" in summary
+    # the summary and the page say where R came from
+    fa = summary["fine_alignment"]
+    assert fa["r_vrw_ug_sqrt_hz"] == fa["measured_vrw_ug_sqrt_hz"] > 300.0
+    assert "the noise the coarse phase measured" in (out_dir / "report.html").read_text()
