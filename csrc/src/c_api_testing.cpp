@@ -133,12 +133,8 @@ double pyins_t_heading_to_yaw(double heading) { return pyins::attitude::heading_
 void pyins_t_compensate(const double dtheta[3], const double dv[3], const double dtheta1[3],
                         const double dv1[3], const double dtheta2[3], const double dv2[3],
                         int32_t count, double phi[3], double dv_p[3]) {
-    pyins::strapdown::History h;
-    h.dtheta1 = v3(dtheta1);
-    h.dv1 = v3(dv1);
-    h.dtheta2 = v3(dtheta2);
-    h.dv2 = v3(dv2);
-    h.count = count;
+    const pyins::strapdown::History h =
+        pyins::strapdown::history_of(v3(dtheta1), v3(dv1), v3(dtheta2), v3(dv2), count);
     const pyins::strapdown::Compensated c = pyins::strapdown::compensate(v3(dtheta), v3(dv), h);
     put3(c.phi, phi);
     put3(c.dv_p, dv_p);
@@ -152,11 +148,8 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     sd.nav.height = s->height;
     sd.nav.vel_n = v3(s->vel_n);
     sd.nav.quat_np = q4(s->quat_np);
-    sd.hist.dtheta1 = v3(s->dtheta1);
-    sd.hist.dv1 = v3(s->dv1);
-    sd.hist.dtheta2 = v3(s->dtheta2);
-    sd.hist.dv2 = v3(s->dv2);
-    sd.hist.count = s->hist_count;
+    sd.hist = pyins::strapdown::history_of(v3(s->dtheta1), v3(s->dv1), v3(s->dtheta2), v3(s->dv2),
+                                           s->hist_count);
     sd.prev_dvel_n = v3(s->prev_dvel_n);
     sd.vertical = s->vertical == 1 ? pyins::strapdown::Vertical::kFree
                                    : pyins::strapdown::Vertical::kHold;

@@ -163,6 +163,8 @@ void init(CoarseAlign& a, const Params& prm) {
     a.hist.dtheta2 = Vec3::Zero();
     a.hist.dv2 = Vec3::Zero();
     a.hist.count = 0;
+    a.hist.cone1 = Vec3::Zero();
+    a.hist.scul1 = Vec3::Zero();
     a.tick = 0;
     a.vel_prev = Vec3::Zero();
     a.pos_ib0 = Vec3::Zero();
@@ -239,7 +241,7 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
     a.vel_ib0 = a.vel_ib0 + attitude::quat_to_mat(a.quat_ib0_p) * c.dv_p;
     a.quat_ib0_p = attitude::quat_normalize(
         attitude::quat_mul(a.quat_ib0_p, attitude::rotvec_to_quat(c.phi)));
-    strapdown::push_history(a.hist, dtheta_p, dv_p);
+    strapdown::push_history(a.hist, dtheta_p, dv_p, c);
     a.tick = a.tick + 1;
 
     // The reference point's v^ib0, less the constant u^p(t0) (added back by

@@ -14,15 +14,19 @@ Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h) {
     Compensated c;
     Vec3 cone = Vec3::Zero();
     Vec3 scul = Vec3::Zero();
+    c.cone_near = Vec3::Zero();
+    c.scul_near = Vec3::Zero();
+    if (h.count >= 1) {
+        c.cone_near = cross(h.dtheta1, dtheta);
+        c.scul_near = cross(h.dtheta1, dv) + cross(h.dv1, dtheta);
+    }
     if (h.count >= 2) {
-        cone = kC3Near * cross(h.dtheta1, dtheta) + kC3Far * cross(h.dtheta2, dtheta) +
-               kC3Past * cross(h.dtheta2, h.dtheta1);
-        scul = kC3Near * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta)) +
-               kC3Far * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta)) +
-               kC3Past * (cross(h.dtheta2, h.dv1) + cross(h.dv2, h.dtheta1));
+        cone = kC3Near * c.cone_near + kC3Far * cross(h.dtheta2, dtheta) + kC3Past * h.cone1;
+        scul = kC3Near * c.scul_near + kC3Far * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta)) +
+               kC3Past * h.scul1;
     } else if (h.count == 1) {
-        cone = kOneTwelfth * cross(h.dtheta1, dtheta);
-        scul = kOneTwelfth * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta));
+        cone = kOneTwelfth * c.cone_near;
+        scul = kOneTwelfth * c.scul_near;
     }
     c.phi = dtheta + cone;
     const Vec3 dv_rot = 0.5 * cross(dtheta, dv) + kOneSixth * cross(dtheta, cross(dtheta, dv));
@@ -30,14 +34,28 @@ Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h) {
     return c;
 }
 
-void push_history(History& h, const Vec3& dtheta, const Vec3& dv) {
+void push_history(History& h, const Vec3& dtheta, const Vec3& dv, const Compensated& c) {
     h.dtheta2 = h.dtheta1;
     h.dv2 = h.dv1;
     h.dtheta1 = dtheta;
     h.dv1 = dv;
+    h.cone1 = c.cone_near;
+    h.scul1 = c.scul_near;
     if (h.count < 2) {
         h.count = h.count + 1;
     }
+}
+
+History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, const Vec3& dv2, int count) {
+    History h;
+    h.dtheta1 = dtheta1;
+    h.dv1 = dv1;
+    h.dtheta2 = dtheta2;
+    h.dv2 = dv2;
+    h.count = count;
+    h.cone1 = cross(dtheta2, dtheta1);
+    h.scul1 = cross(dtheta2, dv1) + cross(dv2, dtheta1);
+    return h;
 }
 
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
@@ -48,6 +66,8 @@ Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     s.hist.dtheta2 = Vec3::Zero();
     s.hist.dv2 = Vec3::Zero();
     s.hist.count = 0;
+    s.hist.cone1 = Vec3::Zero();
+    s.hist.scul1 = Vec3::Zero();
     s.prev_dvel_n = Vec3::Zero();
     s.vertical = vertical;
     s.ref_height = nav.height;
@@ -110,7 +130,7 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     // 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n;
     s.nav.vel_n = vel_new;
-    push_history(s.hist, dtheta_p, dv_p);
+    push_history(s.hist, dtheta_p, dv_p, c);
     return dv_sf_n;
 }
 

@@ -46,6 +46,11 @@ struct History {
     Vec3 dtheta2;    ///< angle increment of tick k-2 [rad]
     Vec3 dv2;        ///< velocity increment of tick k-2 [m/s]
     int count;       ///< how many of those are valid: 0, 1 or 2
+    // The past terms of the three-sample compensation are last tick's near
+    // terms (th2*th1 then was th1*th), kept instead of computed again: the
+    // same operands, the same bits, three cross products fewer a tick.
+    Vec3 cone1;      ///< th2*th1 (valid with count 2) [rad^2]
+    Vec3 scul1;      ///< th2*dv1 + dv2*th1 (valid with count 2) [rad m/s]
 };
 
 /// Everything the update carries from one tick to the next.
@@ -68,8 +73,10 @@ inline constexpr double kOneSixth = 1.0 / 6.0;
 
 /// Rotation vector and velocity increment, compensated.
 struct Compensated {
-    Vec3 phi;    ///< rotation of p over the tick [rad]
-    Vec3 dv_p;   ///< velocity increment in p at the start of the tick [m/s]
+    Vec3 phi;        ///< rotation of p over the tick [rad]
+    Vec3 dv_p;       ///< velocity increment in p at the start of the tick [m/s]
+    Vec3 cone_near;  ///< th1*th (0 without history): next tick's History::cone1
+    Vec3 scul_near;  ///< th1*dv + dv1*th (0 without history): next tick's History::scul1
 };
 
 /// Coning, sculling and rotation compensation of one tick's increments:
@@ -79,10 +86,16 @@ struct Compensated {
 ///   cone = c_n th1*th + c_f th2*th + c_p th2*th1
 ///   scul = c_n (th1*dv + dv1*th) + c_f (th2*dv + dv2*th) + c_p (th2*dv1 + dv2*th1)
 /// for 1 tick: cone = th1*th / 12, scul = (th1*dv + dv1*th) / 12; for none: 0.
+/// The past terms are read from h.cone1, h.scul1 (see History).
 Compensated compensate(const Vec3& dtheta, const Vec3& dv, const History& h);
 
-/// Shift this tick's increments into the history.
-void push_history(History& h, const Vec3& dtheta, const Vec3& dv);
+/// Shift this tick's increments, and its near terms (c, from compensate on
+/// them), into the history.
+void push_history(History& h, const Vec3& dtheta, const Vec3& dv, const Compensated& c);
+
+/// A history from its increments alone, its past terms computed (the test
+/// hooks, which are handed increments).
+History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, const Vec3& dv2, int count);
 
 /// Start a strapdown at a navigation state.
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);

@@ -6,6 +6,7 @@ operations. See the C++ header for the algorithm and its sources (Savage
 coefficients (derived by ``tools/derive_coning.py``).
 """
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,12 +38,25 @@ class NavState:
 
 @dataclass
 class History:
-    """Increments of the ticks before the current one (mirrors History)."""
+    """Increments of the ticks before the current one (mirrors History).
+
+    cone1, scul1: the past terms of the three-sample compensation, last
+    tick's near terms (see History in strapdown.hpp); computed from the
+    increments when not given (what history_of does for the test hooks).
+    """
     dtheta1: np.ndarray = field(default_factory=_zeros)   #: tick k-1 [rad]
     dv1: np.ndarray = field(default_factory=_zeros)       #: tick k-1 [m/s]
     dtheta2: np.ndarray = field(default_factory=_zeros)   #: tick k-2 [rad]
     dv2: np.ndarray = field(default_factory=_zeros)       #: tick k-2 [m/s]
     count: int = 0                                        #: valid entries: 0, 1, 2
+    cone1: np.ndarray = None                              #: th2 x th1
+    scul1: np.ndarray = None                              #: th2 x dv1 + dv2 x th1
+
+    def __post_init__(self):
+        if self.cone1 is None:
+            self.cone1 = cross(self.dtheta2, self.dtheta1)
+        if self.scul1 is None:
+            self.scul1 = cross(self.dtheta2, self.dv1) + cross(self.dv2, self.dtheta1)
 
 
 @dataclass
@@ -55,34 +69,46 @@ class Strapdown:
     ref_lon: float = 0.0
 
 
-def compensate(dtheta, dv, h):
-    """Coning, sculling, rotation compensation; returns ``(phi, dv_p)``.
+class Compensated(NamedTuple):
+    """Mirrors Compensated."""
+    phi: np.ndarray        #: rotation of p over the tick [rad]
+    dv_p: np.ndarray       #: velocity increment in p at the start of the tick [m/s]
+    cone_near: np.ndarray  #: th1 x th (0 without history)
+    scul_near: np.ndarray  #: th1 x dv + dv1 x th (0 without history)
 
-    Mirrors ``pyins::strapdown::compensate``.
-    """
+
+def compensate(dtheta, dv, h):
+    """Coning, sculling, rotation compensation (mirrors
+    ``pyins::strapdown::compensate``); the past terms from h.cone1, h.scul1."""
     cone = np.zeros(3)
     scul = np.zeros(3)
+    cone_near = np.zeros(3)
+    scul_near = np.zeros(3)
+    if h.count >= 1:
+        cone_near = cross(h.dtheta1, dtheta)
+        scul_near = cross(h.dtheta1, dv) + cross(h.dv1, dtheta)
     if h.count >= 2:
-        cone = (C3_NEAR * cross(h.dtheta1, dtheta) + C3_FAR * cross(h.dtheta2, dtheta)
-                + C3_PAST * cross(h.dtheta2, h.dtheta1))
-        scul = (C3_NEAR * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta))
-                + C3_FAR * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta))
-                + C3_PAST * (cross(h.dtheta2, h.dv1) + cross(h.dv2, h.dtheta1)))
+        cone = C3_NEAR * cone_near + C3_FAR * cross(h.dtheta2, dtheta) + C3_PAST * h.cone1
+        scul = (C3_NEAR * scul_near + C3_FAR * (cross(h.dtheta2, dv) + cross(h.dv2, dtheta))
+                + C3_PAST * h.scul1)
     elif h.count == 1:
-        cone = ONE_TWELFTH * cross(h.dtheta1, dtheta)
-        scul = ONE_TWELFTH * (cross(h.dtheta1, dv) + cross(h.dv1, dtheta))
+        cone = ONE_TWELFTH * cone_near
+        scul = ONE_TWELFTH * scul_near
     phi = dtheta + cone
     dv_rot = 0.5 * cross(dtheta, dv) + ONE_SIXTH * cross(dtheta, cross(dtheta, dv))
     dv_p = dv + dv_rot + scul
-    return phi, dv_p
+    return Compensated(phi, dv_p, cone_near, scul_near)
 
 
-def push_history(h, dtheta, dv):
-    """Shift this tick's increments into the history (mirrors push_history)."""
+def push_history(h, dtheta, dv, c):
+    """Shift this tick's increments and near terms (``c``, from
+    `compensate`) into the history (mirrors push_history)."""
     h.dtheta2 = h.dtheta1
     h.dv2 = h.dv1
     h.dtheta1 = np.array(dtheta, dtype=float)
     h.dv1 = np.array(dv, dtype=float)
+    h.cone1 = c.cone_near
+    h.scul1 = c.scul_near
     if h.count < 2:
         h.count = h.count + 1
 
@@ -103,7 +129,8 @@ def update(s, dtheta_p, dv_p, dt):
     Returns the tick's specific-force velocity increment in n [m/s].
     """
     # 1. Coning, sculling and rotation compensation.
-    phi, dv_comp = compensate(dtheta_p, dv_p, s.hist)
+    c = compensate(dtheta_p, dv_p, s.hist)
+    phi, dv_comp = c.phi, c.dv_p
 
     # 2. Earth at the start position, velocity extrapolated to mid-tick.
     vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n
@@ -145,5 +172,5 @@ def update(s, dtheta_p, dv_p, dt):
     # 6. Memory for the next tick.
     s.prev_dvel_n = vel_new - s.nav.vel_n
     s.nav.vel_n = vel_new
-    push_history(s.hist, dtheta_p, dv_p)
+    push_history(s.hist, dtheta_p, dv_p, c)
     return dv_sf_n
