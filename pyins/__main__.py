@@ -208,21 +208,20 @@ def cmd_simulate(args):
                    "Use `pyins run` for closed-loop runs.")
     alpha0 = float(spec.config.get("table_angle_rad", 0.0))
     sensors = sim.SensorModel(spec.errors, seed=spec.seed)
-    parts = []
-    for chunk in sim.generate(spec.motion, spec.duration_ticks, chunk_ticks=200_000, dt=spec.dt,
-                              table=sim.Fixed(alpha0), sensors=sensors, with_truth=False):
-        parts.append((chunk.tick, chunk.dtheta_p, chunk.dv_p, chunk.table_angle))
-    tick = np.concatenate([p[0] for p in parts])
-    data = sim.io.ImuData(tick=tick.astype(np.int64), dtheta_p=np.concatenate([p[1] for p in parts]),
-                          dv_p=np.concatenate([p[2] for p in parts]),
-                          table_angle_rad=np.concatenate([p[3] for p in parts]), dt=spec.dt,
-                          metadata=dict(scenario=scn.text, scenario_name=scn.name, variant=args.variant,
-                                        digest=scn.digest()))
     fmt = logs.format_of(args.log, args.format)
-    logs.write_log(args.log, data, fmt)
-    _say(args, f"pyins simulate {scn.name} [{spec.label}]: {len(tick)} samples "
-               f"({len(tick) * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
-    _emit_json(args, dict(log=args.log, format=fmt, samples=int(len(tick)), scenario=scn.name,
+    metadata = dict(scenario=scn.text, scenario_name=scn.name, variant=args.variant, digest=scn.digest())
+    # written as the chunks come (bounded memory); the file appears under its name when complete
+    n = 0
+    with logs.LogWriter(args.log, fmt, dt=spec.dt, metadata=metadata) as log:
+        for chunk in sim.generate(spec.motion, spec.duration_ticks, chunk_ticks=200_000,
+                                  dt=spec.dt, table=sim.Fixed(alpha0), sensors=sensors, with_truth=False):
+            log.write(sim.io.ImuData(tick=chunk.tick.astype(np.int64), dtheta_p=chunk.dtheta_p,
+                                     dv_p=chunk.dv_p, table_angle_rad=chunk.table_angle, dt=spec.dt,
+                                     metadata=metadata))
+            n += len(chunk.tick)
+    _say(args, f"pyins simulate {scn.name} [{spec.label}]: {n} samples "
+               f"({n * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
+    _emit_json(args, dict(log=args.log, format=fmt, samples=n, scenario=scn.name,
                           variant=spec.label))
     return EXIT_OK
 
@@ -235,13 +234,14 @@ def cmd_replay(args):
         read_kw["table_angle"] = np.radians(args.table_angle)
     if args.columns is not None:
         read_kw["columns"] = logs.parse_columns(args.columns, "--columns")
-    data = logs.read_log(args.log, args.format, strict=not args.allow_gaps,
-                         strict_hint="--allow-gaps replays it, bridging the gaps",
-                         **{k: v for k, v in read_kw.items() if v is not None})
-    if args.allow_gaps:     # the gaps and the bridge, said (metadata["warnings"])
-        data, _ = logs.bridge_gaps(data, how="--allow-gaps")
-        for w in data.metadata["warnings"]:
-            print(f"  WARNING: {w}", file=sys.stderr, flush=True)
+    # the log in blocks (bounded memory); opening it reads the probe: the rate, the header, the unit checks
+    data = logs.LogReader(args.log, args.format, strict=not args.allow_gaps,
+                          strict_hint="--allow-gaps replays it, bridging the gaps",
+                          **{k: v for k, v in read_kw.items() if v is not None})
+    blocks, bridge = data.blocks(), None
+    if args.allow_gaps:     # the gaps, and the bridge, said when the log has been read
+        bridge = logs.GapBridge(how="--allow-gaps")
+        blocks = bridge.blocks(blocks)
     scn = None
     if args.scenario:
         scn = scenario.load(args.scenario)
@@ -263,8 +263,21 @@ def cmd_replay(args):
     every = args.every if args.every is not None else hz
     if args.reference is not None and spec is not None:
         raise InputError("--reference: the log's scenario is its reference already (drop --reference)")
-    summary = replay.replay(data, cfg, out_dir, every=every, spec=spec, engine=args.engine,
-                            log_path=args.log, reference=args.reference)
+    bar = _progress(args)
+    bar = bar(f"replaying {args.log}") if bar is not None and data.n else None
+    try:
+        summary = replay.replay(blocks, cfg, out_dir, every=every, spec=spec, engine=args.engine,
+                                log_path=args.log, reference=args.reference,
+                                progress=None if bar is None else (lambda done: bar(min(done, data.n), data.n)))
+    except KeyboardInterrupt:
+        if os.path.exists(os.path.join(out_dir, "summary.json")):
+            print(f"\npyins replay: interrupted; the records so far are in {out_dir} (summary.json says "
+                  f"\"interrupted\"): `pyins report {out_dir}` renders them", file=sys.stderr)
+        else:
+            print("\npyins replay: interrupted before the first record: nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    for w in data.warnings + ([bridge.note()] if bridge is not None and bridge.note() else []):
+        print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     page = report.render(out_dir)
     _say(args, f"pyins replay {args.log}: {summary['samples']} samples at {hz} Hz "
                f"-> {out_dir}/navigation.npz")
@@ -272,6 +285,12 @@ def cmd_replay(args):
         al = summary["aligned"]
         _say(args, f"  aligned at {al['time_s']:g} s: pitch {al['pitch_deg']:.4f} deg, roll "
                    f"{al['roll_deg']:.4f} deg, heading {al['heading_deg']:.4f} deg")
+    fa = summary.get("fine_alignment") or {}
+    if "r_vrw_ug_sqrt_hz" in fa:
+        measured = fa["measured_vrw_ug_sqrt_hz"]
+        _say(args, f"  fine alignment: R from {fa['r_vrw_ug_sqrt_hz']:.1f} ug/sqrt(Hz) ("
+                   + ("measured in the coarse phase" if measured > 0.0 and measured == fa["r_vrw_ug_sqrt_hz"]
+                      else "configured") + f"), heading sigma {fa['sigma_heading_arcmin']:.2f}', NIS {fa['nis']:.2f}")
     fin = summary["final"]
     _say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, mode {fin['mode']}, "
                f"faults {fin['fault_flags']}")
@@ -461,6 +480,9 @@ def build_parser():
                    help="initial attitude sigmas of the fine filter, with units, e.g. 10\' 10\' 60\'")
     p.add_argument("--gyro-arw", help="gyro noise the fine filter assumes, e.g. \"0.001 deg/sqrt(h)\"")
     p.add_argument("--accel-vrw", help="accelerometer noise the fine filter assumes, e.g. \"10 ug/sqrt(Hz)\"")
+    p.add_argument("--fine-noise", choices=sorted(scenario.FINE_NOISES),
+                   help="the static fine filters' R: measured (default: the larger of --accel-vrw and the "
+                        "noise the coarse phase measures, vibration included) or configured (--accel-vrw alone)")
     p.add_argument("--vertical", choices=("hold", "free"), help="vertical channel (default hold)")
     p.add_argument("--every", type=int, help="record every N samples (default: one a second)")
     p.add_argument("--reference", choices=replay.REFERENCES,

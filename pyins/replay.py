@@ -2,8 +2,12 @@
 
 `replay` is a guarded prefix, then named steps:
 
-1. the log through the firmware, one record every ``every`` samples
-   (navigation.npz);
+1. the log through the firmware in blocks (a `pyins.logs.LogReader`'s, or
+   an ImuData split into `BLOCK` samples), one firmware call a block, one
+   record every ``every`` samples, written as they come (navigation.npz is
+   assembled from them at the end): memory does not grow with the log, and
+   Ctrl-C between blocks leaves the records so far with a summary saying
+   ``"state": "interrupted"``;
 2. what the run says: the final state, the attitude at the end of the
    alignment, the fine alignment's sigmas and drift estimates, and the
    warnings for anything its figures cannot be trusted for (`warnings`);
@@ -11,7 +15,9 @@
    scenario the log was simulated from, or ``reference="parked"`` (the
    configured site and zero velocity: a vehicle or a ship at the pier that
    did not move), north and east apart (errors.npz);
-4. summary.json; the page and figures are `pyins.report.replay`.
+4. summary.json (the figures of step 2 and 3 gathered block by block: a
+   record, a maximum or a last value each, the same as from all records at
+   once); the page and figures are `pyins.report.replay`.
 
 The CLI checks the user's options before any of this (the rate, an
 attitude someone gave, the firmware's limits: `pyins.__main__`,
@@ -23,17 +29,20 @@ import os
 import numpy as np
 
 from pyins import engine as engines
-from pyins import metrics, native, runner, scenario, sim
+from pyins import logs, metrics, native, records, runner, scenario, sim
 from pyins.reference import abi
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
+from pyins.runs import hold_interrupts
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
 
 __all__ = ["replay", "replay_config", "warnings", "REFERENCES"]
 
 #: the references a log's errors can be taken against without a scenario
 REFERENCES = ("parked",)
+#: samples per firmware call (`pyins.logs.DEFAULT_BLOCK`): 655 s at 100 Hz, ~0.1 s of work
+BLOCK = logs.DEFAULT_BLOCK
 
 def replay_config(spec):
     """The firmware configuration replaying a log of ``spec`` (a RunSpec)
@@ -84,12 +93,109 @@ def _parked_errors(recs, cfg, hz):
     return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
 
 
-def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None):
-    """Run a recorded IMU log (``data``: a pyins.sim.io.ImuData) through the
-    firmware configured by ``cfg`` into ``out_dir`` and return the summary
-    dict (also summary.json). ``spec``: the RunSpec the log was simulated
-    from (its truth is the reference); ``reference="parked"``: the site and
-    zero velocity."""
+class _Summary:
+    """What the summary needs of the records, gathered block by block: the
+    first and last record, the first record in navigation, the last of the
+    fine alignment, and the errors' maxima and last values (the errors
+    themselves go to errors.npz as they come). The same figures as from all
+    the records at once: each is a record, a max or a last value, and the
+    errors are record by record (`metrics.nav_errors`, `sim.truth_at`)."""
+
+    def __init__(self, cfg, hz, spec, reference, errors):
+        self.cfg, self.hz, self.spec, self.reference, self.errors = cfg, hz, spec, reference, errors
+        self.records = 0
+        self.last = self.first_nav = self.last_fine = None
+        self.horizontal_max = self.level_max = self.speed_max = -np.inf
+        self.e_last = None
+
+    def add(self, recs):
+        self.records += len(recs)
+        self.last = recs[-1:].copy()
+        if self.first_nav is None:
+            nav = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE)
+            if len(nav):
+                self.first_nav = recs[nav[0]:nav[0] + 1].copy()
+        fine = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_FINE_ALIGN)
+        if len(fine):
+            self.last_fine = recs[fine[-1]:fine[-1] + 1].copy()
+        if self.spec is not None:
+            truth = sim.truth_at(self.spec.motion, recs["tick"], dt=self.spec.dt)
+            e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=self.spec.dt))
+            err = dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
+            self.horizontal_max = max(self.horizontal_max, float(e.horizontal_m.max()))
+            self.level_max = max(self.level_max, float(np.abs(e.att_n_rad[:, :2]).max()))
+            self.e_last = dict(horizontal=float(e.horizontal_m[-1]), heading=float(e.att_n_rad[-1, 2]))
+        elif self.reference == "parked":
+            err = _parked_errors(recs, self.cfg, self.hz)
+            horizontal = np.hypot(err["north_m"], err["east_m"])
+            speed = np.linalg.norm(err["vel_n_mps"][:, :2], axis=1)
+            self.horizontal_max = max(self.horizontal_max, float(horizontal.max()))
+            self.speed_max = max(self.speed_max, float(speed.max()))
+            self.e_last = dict(horizontal=float(horizontal[-1]), north=float(err["north_m"][-1]),
+                               east=float(err["east_m"][-1]))
+        else:
+            return
+        for key, value in err.items():
+            self.errors.append(key, value)
+
+    def summary(self, log_path, samples, every):
+        cfg, hz, recs = self.cfg, self.hz, self.last
+        summary = dict(log=os.path.abspath(log_path) if log_path else None, samples=int(samples),
+                       rate_hz=int(hz), every=every,
+                       final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
+                                  lon_deg=float(np.degrees(recs["lon_rad"][-1])),
+                                  euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
+                                  mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
+        aligning = cfg.get("coarse_ticks", 0) > 0 or cfg.get("fine_ticks", 0) > 0
+        if aligning and self.first_nav is not None:
+            first = self.first_nav
+            pitch, roll, yaw = np.degrees(first["euler_b_rad"][0])
+            summary["aligned"] = dict(time_s=float(first["tick"][0] / hz), pitch_deg=float(pitch),
+                                      roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)))
+        fine = alignment_figures(self.last_fine) if self.last_fine is not None else None
+        if fine is not None:
+            summary["fine_alignment"] = fine
+        summary["warnings"] = warnings(recs, aligning, hz)
+        if self.spec is not None:
+            summary["errors"] = dict(reference=f"the truth of {self.spec.scenario}",
+                                     horizontal_max_m=self.horizontal_max,
+                                     horizontal_final_m=self.e_last["horizontal"],
+                                     heading_final_arcmin=self.e_last["heading"] / ARCMIN_TO_RAD,
+                                     level_max_arcsec=self.level_max / ARCSEC_TO_RAD)
+        elif self.reference == "parked":
+            summary["errors"] = dict(reference="the site, parked (zero velocity)",
+                                     horizontal_max_m=self.horizontal_max,
+                                     horizontal_final_m=self.e_last["horizontal"],
+                                     north_final_m=self.e_last["north"], east_final_m=self.e_last["east"],
+                                     speed_max_mps=self.speed_max)
+        return summary
+
+
+def _blocks(data, block):
+    """``data`` in blocks: an ImuData split (`pyins.logs.split_blocks`), or
+    the blocks of an iterable (a `pyins.logs.LogReader`) as they come."""
+    if hasattr(data, "tick"):
+        return logs.split_blocks(data, block)
+    return iter(data)
+
+
+def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None,
+           block=BLOCK, progress=None):
+    """Run a recorded IMU log through the firmware configured by ``cfg`` into
+    ``out_dir`` and return the summary dict (also summary.json). ``data``: a
+    pyins.sim.io.ImuData, or an iterable of them in order (the blocks of a
+    `pyins.logs.LogReader`): each block is one firmware call (``every`` is in
+    phase across calls), its records and errors written as they come, so the
+    memory does not grow with the log. ``spec``: the RunSpec the log was
+    simulated from (its truth is the reference); ``reference="parked"``: the
+    site and zero velocity. ``progress(samples_done)`` after each block.
+
+    Ctrl-C (KeyboardInterrupt) between blocks, or in one (a block is at most
+    ``block`` samples: well under a second): the records so far are written
+    with a summary that says ``"state": "interrupted"``, ``"complete":
+    false`` (`pyins report` renders it), and the interrupt is raised again.
+    A log refused part way (`pyins.logs.LogError`) or a firmware error
+    leaves no navigation.npz or summary.json."""
     # the guarded prefix
     engines.check(engine)
     every = max(1, int(every))
@@ -97,59 +203,54 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
         raise ValueError(f"reference: {reference!r} is not one of {', '.join(REFERENCES)}")
     hz = cfg.get("tick_hz") or TICK_HZ
 
-    # 1. the log through the firmware
+    # 1. the log through the firmware, block by block, the records written as they come
     fw = engines.firmware(engine, cfg)
-    samples = native.make_samples(data.dtheta_p, data.dv_p, data.table_angle_rad)
+    made = not os.path.isdir(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    recs = fw.run(samples, every=every)
-    if not len(recs):
-        raise ValueError(f"{log_path or 'the log'}: {len(samples)} samples, fewer than one record "
-                         f"interval ({every} samples): nothing to report (a smaller --every, or a longer log)")
-    np.savez(os.path.join(out_dir, "navigation.npz"), outputs=recs)
-
-    # 2. what the run says
-    summary = dict(log=os.path.abspath(log_path) if log_path else None, samples=int(len(samples)),
-                   rate_hz=int(hz), every=every,
-                   final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
-                              lon_deg=float(np.degrees(recs["lon_rad"][-1])),
-                              euler_deg=np.degrees(recs["euler_b_rad"][-1]).tolist(),
-                              mode=int(recs["mode"][-1]), fault_flags=int(recs["fault_flags"][-1])))
-    aligning = cfg.get("coarse_ticks", 0) > 0 or cfg.get("fine_ticks", 0) > 0
-    nav = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE)
-    if aligning and len(nav):
-        k = nav[0]
-        pitch, roll, yaw = np.degrees(recs["euler_b_rad"][k])
-        summary["aligned"] = dict(time_s=float(recs["tick"][k] / hz), pitch_deg=float(pitch),
-                                  roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)))
-    fine = alignment_figures(recs)
-    if fine is not None:
-        summary["fine_alignment"] = fine
-    summary["warnings"] = warnings(recs, aligning, hz)
-
-    # 3. the errors against a reference
-    err = None
-    if spec is not None:
-        truth = sim.truth_at(spec.motion, recs["tick"], dt=spec.dt)
-        e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=spec.dt))
-        err = dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
-        summary["errors"] = dict(reference=f"the truth of {spec.scenario}",
-                                 horizontal_max_m=float(e.horizontal_m.max()),
-                                 horizontal_final_m=float(e.horizontal_m[-1]),
-                                 heading_final_arcmin=float(e.att_n_rad[-1, 2] / ARCMIN_TO_RAD),
-                                 level_max_arcsec=float(np.abs(e.att_n_rad[:, :2]).max() / ARCSEC_TO_RAD))
-    elif reference == "parked":
-        err = _parked_errors(recs, cfg, hz)
-        horizontal = np.hypot(err["north_m"], err["east_m"])
-        speed = np.linalg.norm(err["vel_n_mps"][:, :2], axis=1)
-        summary["errors"] = dict(reference="the site, parked (zero velocity)",
-                                 horizontal_max_m=float(horizontal.max()),
-                                 horizontal_final_m=float(horizontal[-1]),
-                                 north_final_m=float(err["north_m"][-1]), east_final_m=float(err["east_m"][-1]),
-                                 speed_max_mps=float(speed.max()))
-    if err is not None:
-        np.savez(os.path.join(out_dir, "errors.npz"), **err)
-
-    # 4. summary.json
-    with open(os.path.join(out_dir, "summary.json"), "w", encoding="utf-8") as f:
-        json.dump(summary, f, indent=2)
+    nav = logs.NpzWriter(os.path.join(out_dir, "navigation.npz"))
+    err = logs.NpzWriter(os.path.join(out_dir, "errors.npz"))
+    acc = _Summary(cfg, hz, spec, reference, err)
+    samples, interrupted = 0, False
+    try:
+        try:
+            for piece in _blocks(data, block):
+                chunk = native.make_samples(piece.dtheta_p, piece.dv_p, piece.table_angle_rad)
+                recs = fw.run(chunk, every=every)
+                samples += len(chunk)
+                if len(recs):
+                    nav.append("outputs", recs)
+                    acc.add(recs)
+                if progress is not None:
+                    progress(samples)
+        except KeyboardInterrupt:
+            interrupted = True
+        # 2. what the run says; 3. the errors against a reference; 4. summary.json
+        with hold_interrupts(defer=not interrupted):
+            if not acc.records:
+                if interrupted:
+                    raise KeyboardInterrupt
+                raise ValueError(f"{log_path or 'the log'}: {samples} samples, fewer than one record "
+                                 f"interval ({every} samples): nothing to report (a smaller --every, or a "
+                                 f"longer log)")
+            summary = acc.summary(log_path, samples, every)
+            if interrupted:
+                t = float(acc.last["tick"][0] / hz)
+                summary.update(complete=False, state="interrupted")
+                summary["warnings"].insert(0, f"interrupted (Ctrl-C) at {t:g} s after {samples} samples: "
+                                              "the log was not replayed to its end")
+            nav.close()
+            if err.rows("time_s"):
+                err.close()
+            else:
+                err.abort()
+            records.write_atomic(os.path.join(out_dir, "summary.json"), json.dumps(summary, indent=2),
+                                 sync=False)
+    except BaseException:
+        nav.abort()
+        err.abort()
+        if made and not os.listdir(out_dir):
+            os.rmdir(out_dir)
+        raise
+    if interrupted:
+        raise KeyboardInterrupt
     return summary

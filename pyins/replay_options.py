@@ -40,7 +40,9 @@ NAMES = {"tick_hz": "--rate", "lat_rad": "--lat", "lon_rad": "--lon", "height_m"
 def rate_hz(args, data, spec):
     """The log's sample rate [Hz] as the firmware's whole-number tick rate:
     from the log (its time column, its dt, or --dt), else --rate, else the
-    scenario's; any two that disagree by more than 1 % are an error."""
+    scenario's; any two that disagree by more than 1 % are an error.
+    ``data``: anything with ``dt`` and ``metadata`` (a `pyins.logs.LogReader`,
+    whose probe gave them before the first block, or an ImuData)."""
     rate, where = None, None
     if data.dt:
         rate, where = 1.0 / data.dt, ("--dt" if args.dt is not None else f"the log ({args.log})")
@@ -78,7 +80,8 @@ def quantity(option, text, dimension):
 def config(args, data, spec, cfg, say=print):
     """The firmware configuration of a replay and its tick rate [Hz]: ``cfg``
     (the scenario's, or empty) completed from the options ``args`` and the
-    log ``data``; ``say`` prints a notice."""
+    log ``data`` (its ``dt`` and ``metadata``: a `pyins.logs.LogReader` or an
+    ImuData); ``say`` prints a notice."""
     # 1. the rate
     hz = rate_hz(args, data, spec)
     cfg["tick_hz"] = hz
@@ -113,6 +116,8 @@ def config(args, data, spec, cfg, say=print):
         cfg["fine_states"] = args.fine_states
     if args.fine_correction is not None:
         cfg["fine_correction"] = scenario.FINE_CORRECTIONS[args.fine_correction]
+    if args.fine_noise is not None:
+        cfg["fine_noise"] = scenario.FINE_NOISES[args.fine_noise]
     if args.vertical is not None:
         cfg["vertical_mode"] = args.vertical
     if args.fine_sigma0 is not None:

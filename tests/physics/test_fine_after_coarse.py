@@ -180,3 +180,23 @@ def test_the_real_log_keeps_its_coarse_heading(tmp_path):
     fa = summary["fine_alignment"]
     assert fa["r_vrw_ug_sqrt_hz"] == fa["measured_vrw_ug_sqrt_hz"] > 300.0
     assert "the noise the coarse phase measured" in (out_dir / "report.html").read_text()
+
+
+def test_the_real_log_with_the_configured_noise_alone_is_flagged(tmp_path):
+    """The same replay with ``--fine-noise configured`` (R from the default
+    10 ug/sqrt(Hz), the behaviour before the noise was measured): the heading
+    leaves the coarse value by more than 1 deg and the firmware says the
+    measurements do not fit (ALIGN_INCONSISTENT, a warning, no valid
+    attitude) rather than reporting it as aligned."""
+    out_dir = tmp_path / "run"
+    rc = cli.main(["replay", LOG, "--lat", "34.246048", "--lon", "108.909664", "--height", "380",
+                   "--coarse", "120", "--fine", "120", "--every", "10", "--fine-noise", "configured",
+                   "--out", str(out_dir), "--quiet"])
+    assert rc == 0
+    summary = json.loads((out_dir / "summary.json").read_text())
+    out = np.load(out_dir / "navigation.npz")["outputs"]
+    fine = np.flatnonzero(out["mode"] == 2)
+    assert heading_excursion(out, fine, fine[0] - 1) > 1.0 * DEG
+    assert out["fine_vrw"][fine[-1]] == config.DEFAULT_FINE_VRW and out["coarse_vrw"][-1] == 0.0
+    assert out["fault_flags"][-1] & abi.PYINS_FAULT_ALIGN_INCONSISTENT
+    assert any("integrity test failed" in w for w in summary["warnings"])
