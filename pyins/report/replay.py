@@ -231,7 +231,9 @@ def render(out_dir):
             "<style>body{font-family:sans-serif;max-width:1200px;margin:1em auto}"
             "table{border-collapse:collapse}th,td{border:1px solid #ccc;padding:4px 8px;text-align:left}"
             "img{max-width:100%}.warn{color:#a00}</style></head><body>",
-            f"<h1>Replay of {html.escape(os.path.basename(str(summary.get('log'))))}</h1>",
+            f"<h1>Replay of {html.escape(os.path.basename(str(summary.get('log'))))}"
+            + (" &mdash; PARTIAL: interrupted before the log's end" if summary.get("complete") is False else "")
+            + "</h1>",
             f"<ul class='warn'>{warn}</ul>" if warn else "<p>No warnings: the figures below can be trusted "
             "as far as the firmware can tell.</p>",
             "<table>", *rows, "</table>",

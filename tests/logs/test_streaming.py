@@ -319,6 +319,7 @@ def test_ctrl_c_between_blocks_leaves_a_summary_that_says_interrupted(tmp_path, 
     assert s["warnings"][0].startswith("interrupted (Ctrl-C) at 60 s")
     assert [f for f in os.listdir(out) if "part" in f or "tmp" in f] == []
     assert cli.main(["report", str(out), "--quiet"]) == 0
+    assert "PARTIAL: interrupted" in (out / "report.html").read_text()     # the page says so first
 
 
 def test_ctrl_c_stops_pyins_replay_within_seconds(tmp_path):
