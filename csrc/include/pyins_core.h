@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 10
+#define PYINS_ABI_VERSION_MINOR 11
 
 #ifdef __cplusplus
 extern "C" {
@@ -336,6 +336,16 @@ typedef struct pyins_output {
                                      [(m/s)/sqrt(s)] (fine_noise); 0 before it starts and for fine_states 12 */
 } pyins_output;
 
+/* What the turntable's motor controller reads after every step, without
+ * the cost of a record (pyins_get_motor_command): the same values as the
+ * record's fields of the same meaning. */
+typedef struct pyins_motor_command {
+    double rate_rad_s;            /* = pyins_output.motor_rate_cmd_rad_s: commanded table rate */
+    double angle_rad;             /* = pyins_output.table_angle_cmd_rad: commanded (unwrapped) angle */
+    int32_t index_state;          /* = pyins_output.index_state (enum pyins_index_state) */
+    int32_t index_fault;          /* = pyins_output.index_fault */
+} pyins_motor_command;
+
 /* The firmware instance. Opaque: it lives in caller memory of
  * pyins_core_size() bytes aligned to pyins_core_align(). */
 typedef struct pyins_core pyins_core;
@@ -426,6 +436,13 @@ int pyins_restore(void *mem, size_t mem_size, const void *buf, size_t buf_size);
 /* Write the current state as an output record (no step).
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_get_output(const pyins_core *core, pyins_output *out);
+
+/* Write the indexing motor's command after the last step (no record is
+ * built: a closed loop that reads the command every tick and a record every
+ * second steps with pyins_run(core, &sample, 1, NULL, NULL), reads this, and
+ * takes pyins_get_output only at its record ticks; the same bits as a
+ * record every tick). Returns PYINS_OK or a negative pyins_status. */
+int pyins_get_motor_command(const pyins_core *core, pyins_motor_command *cmd);
 
 /* Static, human-readable name and meaning of a status code. Never NULL. */
 const char *pyins_status_str(int status);

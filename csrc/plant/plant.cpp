@@ -3,6 +3,9 @@
 #include "pyins_plant.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 
 #include "angle.hpp"
 
@@ -53,6 +56,19 @@ void apply_errors(const double m[9], const double bias[3], double quantum, const
 
 }  // namespace
 
+namespace {
+
+/// The same double, bit for bit (-0.0 is not 0.0: its sine is -0.0).
+bool same_bits(double a, double b) {
+    uint64_t ua = 0;
+    uint64_t ub = 0;
+    std::memcpy(&ua, &a, sizeof ua);
+    std::memcpy(&ub, &b, sizeof ub);
+    return ua == ub;
+}
+
+}  // namespace
+
 extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyins_table_config* table,
                              const pyins_imu_errors* err, const double* node_omega_b,
                              const double* node_force_b, const double* node_x, const double* node_w,
@@ -79,7 +95,10 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
     }
     const double half = 0.5 * dt;
     size_t written = 0;
-    pyins_output out;
+    pyins_motor_command cmd;
+    double trig_alpha = std::numeric_limits<double>::quiet_NaN();  // no angle yet
+    double trig_c = 1.0;
+    double trig_s = 0.0;
     for (size_t k = 0; k < n; ++k) {
         const int64_t base = ((phase0 + static_cast<int64_t>(k)) % period) * n_nodes;
         const double a = table_accel(*table, *st, dt);
@@ -89,8 +108,15 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
             const double tau = 0.5 * (1.0 + node_x[j]) * dt;
             const double alpha = st->alpha_rad + st->rate_rad_s * tau + 0.5 * a * tau * tau;
             const double alpha_dot = st->rate_rad_s + a * tau;
-            const double c = std::cos(alpha);
-            const double s = std::sin(alpha);
+            // a table at rest has the same angle at every node and tick: its
+            // cosine and sine are computed once (the same bits as again)
+            if (!same_bits(alpha, trig_alpha)) {
+                trig_alpha = alpha;
+                trig_c = std::cos(alpha);
+                trig_s = std::sin(alpha);
+            }
+            const double c = trig_c;
+            const double s = trig_s;
             const double* w_b = node_omega_b + 3 * (base + j);
             const double* f_b = node_force_b + 3 * (base + j);
             // omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot z;  f^p = Rz(alpha)^T f^b
@@ -129,16 +155,19 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
         sample.seq = static_cast<uint32_t>(st->tick);
         sample.reserved = 0u;
 
-        const int status = pyins_step(core, &sample, &out);
+        // one step without a record: the motor reads its command every tick,
+        // the record is built only at the kept ticks (the same bits)
+        const int status = pyins_run(core, &sample, 1, nullptr, nullptr);
         if (status < 0) {  // rejected; notices (e.g. an encoder jump) go on
             return status;
         }
-        st->rate_cmd_rad_s = out.motor_rate_cmd_rad_s;
+        pyins_get_motor_command(core, &cmd);
+        st->rate_cmd_rad_s = cmd.rate_rad_s;
         if (n_done != nullptr) {
             *n_done = k + 1;
         }
         if (static_cast<uint64_t>(st->tick) % static_cast<uint64_t>(every) == 0u) {
-            outputs[written] = out;
+            pyins_get_output(core, &outputs[written]);
             records[written].tick = st->tick;
             records[written].alpha_rad = st->alpha_rad;
             records[written].rate_rad_s = st->rate_rad_s;

@@ -301,6 +301,19 @@ int pyins_get_output(const pyins_core* core, pyins_output* out) {
     return PYINS_OK;
 }
 
+int pyins_get_motor_command(const pyins_core* core, pyins_motor_command* cmd) {
+    const Firmware* fw = nullptr;
+    const int status = checked(core, &fw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (cmd == nullptr) {
+        return PYINS_E_NULL;
+    }
+    fw->motor_command(cmd);
+    return PYINS_OK;
+}
+
 const char* pyins_status_str(int status) {
     switch (status) {
         case PYINS_OK: return "PYINS_OK: success";

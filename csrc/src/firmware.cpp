@@ -728,6 +728,13 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     tick_ = tick_ + 1;
 }
 
+void Firmware::motor_command(pyins_motor_command* cmd) const {
+    cmd->rate_rad_s = idx_.cmd_rate;
+    cmd->angle_rad = idx_.cmd_angle;
+    cmd->index_state = static_cast<int32_t>(idx_.state);
+    cmd->index_fault = static_cast<int32_t>(idx_.fault);
+}
+
 void Firmware::output(pyins_output* out) const {
     const strapdown::NavState& nav = sd_.nav;
     out->tick = tick_;

@@ -73,6 +73,8 @@ class Firmware {
 
     /// The current state as an output record.
     void output(pyins_output* out) const;
+    /// The motor command fields of output(), alone (pyins_get_motor_command).
+    void motor_command(pyins_motor_command* cmd) const;
 
     /// Leave the indexing FAULT state (pyins_index_reset).
     void index_reset();

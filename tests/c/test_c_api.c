@@ -290,6 +290,9 @@ int main(void) {
         check_status(pyins_step(core, &s, NULL), PYINS_E_NULL, "step NULL output");
         check_status(pyins_get_output(core, NULL), PYINS_E_NULL, "get_output NULL");
         check_status(pyins_get_output(NULL, &out), PYINS_E_NULL, "get_output NULL core");
+        check_status(pyins_get_motor_command(core, NULL), PYINS_E_NULL, "get_motor_command NULL");
+        check_status(pyins_get_motor_command(NULL, (pyins_motor_command *)&out), PYINS_E_NULL,
+                     "get_motor_command NULL core");
         check_status(pyins_run(core, NULL, 3, NULL, &n_done), PYINS_E_NULL, "run NULL samples");
         check(n_done == 0, "run NULL samples: n_done 0");
         check_status(pyins_run(core, NULL, 0, NULL, NULL), PYINS_OK, "run zero samples");

@@ -493,8 +493,15 @@ static void check_output(const pyins_output *o) {
 }
 
 static void get_a(fuzz *f, pyins_output *o) {
+    pyins_motor_command cmd;
     REQUIRE_EQ(pyins_get_output((const pyins_core *)f->a, o), PYINS_OK, "get_output on a live instance");
     check_output(o);
+    /* the motor command alone is the record's, bit for bit */
+    REQUIRE_EQ(pyins_get_motor_command((const pyins_core *)f->a, &cmd), PYINS_OK, "get_motor_command");
+    REQUIRE(memcmp(&cmd.rate_rad_s, &o->motor_rate_cmd_rad_s, sizeof(double)) == 0 &&
+            memcmp(&cmd.angle_rad, &o->table_angle_cmd_rad, sizeof(double)) == 0 &&
+            cmd.index_state == o->index_state && cmd.index_fault == o->index_fault,
+            "motor command == the record's fields");
 }
 
 /* After a call that may have stepped: sticky fault bits, output ranges. */
