@@ -27,7 +27,7 @@ import numpy as np
 
 from pyins import (__version__, bench, campaign, engine, logs, metrics, native, replay, replay_options, report,
                    runner, runs, scenario, sim)
-from pyins.progress import TextProgress
+from pyins.progress import Phases, TextProgress, phase
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, TICK_HZ
 
 _TICKS_PER_HOUR = 3600 * TICK_HZ
@@ -122,6 +122,11 @@ def _progress(args):
     return make
 
 
+def _phases(args):
+    """A line on stderr per phase after the firmware (reading the records, the figures), or None."""
+    return None if getattr(args, "quiet", False) or getattr(args, "json", False) else Phases()
+
+
 def _emit_json(args, obj):
     if getattr(args, "json", False):
         print(json.dumps(obj, indent=2, default=float))
@@ -176,7 +181,7 @@ def cmd_run(args):
         print(f"\npyins run: interrupted; the partial result is in {out}: `pyins report {out}` renders "
               f"it, `pyins run ... --out {out} --resume` continues it", file=sys.stderr)
         return EXIT_INTERRUPTED
-    path = report.render(out)
+    path = report.render(out, progress=_phases(args))
     for line in _summary_lines(summary):
         _say(args, line)
     _say(args, f"  report: {path}")
@@ -316,8 +321,9 @@ def cmd_report(args):
         what = ("the run stopped before it wrote its summary" if os.path.exists(
             os.path.join(args.rundir, "resolved_scenario.json")) else "not a run directory")
         raise InputError(f"{args.rundir}: {what} (no readable summary.json)")
-    summary, series = report.run.load(args.rundir)
-    path = report.render(args.rundir, loaded=(summary, series))
+    with phase(_phases(args), "report: reading the records"):
+        summary, series = report.run.load(args.rundir)
+    path = report.render(args.rundir, loaded=(summary, series), progress=_phases(args))
     partial = not summary.get("complete")
     _say(args, f"report: {path}" + (f"  [PARTIAL, {summary.get('stopped', 'interrupted')}: the figures "
                                     "cover the ticks done]" if partial else ""))

@@ -7,7 +7,10 @@ A run directory holds::
     scenario.toml              the scenario as written (built-ins: their file)
     resolved_scenario.json     every value in SI units, as run
     summary.json               per variant: metrics (SI, units in the names),
-                               ticks done, wall time; the paper's figures
+                               ticks done, wall time, its duration as run and
+                               as the scenario file writes it, whether its
+                               scheme uses the flexible sums; the paper's
+                               figures
     <variant>/records/         the firmware and plant records (fil.run_fil
                                record_dir: raw binary, checkpoints)
     <variant>/timeseries.npz   the records and the errors against the truth
@@ -42,12 +45,15 @@ import numpy as np
 from pyins import engine as engines
 from pyins import fil, metrics, native, records, scenario, sim
 from pyins.metrics import group_metrics
+from pyins.progress import phase
+from pyins.reference import abi
 from pyins.records import CSV_MAX_ROWS
 from pyins.units import ARCMIN_TO_RAD, ScenarioError
 
 __all__ = ["execute", "run", "load_variant", "load_written", "paper_rows", "slug",
            "group_metrics", "check_run_dir", "clean_run_dir", "dir_digest", "read_summary", "scenario_of",
-           "written_ticks", "hold_interrupts", "RunDirError", "CHECKPOINT_S", "CSV_MAX_ROWS", "SUMMARY", "RUN_FILES"]
+           "written_ticks", "written_durations", "not_judged", "span", "uses_index_sums", "variant_facts",
+           "hold_interrupts", "RunDirError", "CHECKPOINT_S", "CSV_MAX_ROWS", "SUMMARY", "RUN_FILES"]
 
 CHECKPOINT_S = 1800.0          # ship time between checkpoints: 30 min = 180,000 ticks
 SUMMARY = "summary.json"
@@ -161,9 +167,40 @@ def clean_run_dir(run_dir):
             os.remove(path)
 
 
-def _entry(spec):
+def uses_index_sums(config):
+    """True when the indexing scheme of a firmware ``config`` (a RunSpec's)
+    steers by the flexible sums A_c, A_s: the flexible schemes, and a custom
+    one with a flexible step. The firmware adds them up under every rotating
+    scheme; only these read them."""
+    scheme = config.get("index_scheme", abi.PYINS_INDEX_NONE)
+    if scheme in (abi.PYINS_INDEX_FLEXIBLE_TWO, abi.PYINS_INDEX_FLEXIBLE_DERIVED):
+        return True
+    return scheme == abi.PYINS_INDEX_CUSTOM and any(
+        move != abi.PYINS_INDEX_FIXED for _, move, _ in config.get("index_steps", ()))
+
+
+def written_durations(scn):
+    """label -> duration [s] of each run of ``scn`` as its file writes it,
+    before any override (``--hours``, ``--set duration=``): the length its
+    [paper] figures are for. {} when the text does not load on its own."""
+    try:
+        base = scenario.loads(scn.text, source=str(scn.source), name=getattr(scn, "_stem", scn.name))
+    except (ScenarioError, ValueError, TypeError, KeyError, OSError):
+        return {}
+    return {spec.label: spec.duration_ticks * spec.dt for spec in base.runs()}
+
+
+def variant_facts(spec, written):
+    """What a report reads of a variant beside its records: its duration as
+    run and as written (``written``: `written_durations`), whether its scheme
+    uses the flexible sums."""
+    return dict(duration_s=spec.duration_ticks * spec.dt, written_duration_s=written.get(spec.label),
+                uses_index_sums=uses_index_sums(spec.config))
+
+
+def _entry(spec, written):
     return dict(label=spec.label, dir=slug(spec.label), ticks=spec.duration_ticks, ticks_done=0,
-                complete=False, wall_s=0.0, metrics={})
+                complete=False, wall_s=0.0, metrics={}, **variant_facts(spec, written))
 
 
 def written_ticks(run_dir, spec):
@@ -253,7 +290,9 @@ def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native"
     ``run_dir``; returns the summary dict (also written to summary.json).
 
     ``progress(label)`` returns a callable progress(done, total) per variant
-    (e.g. ``lambda label: TextProgress()``); ``log(text)`` gets one line per
+    (e.g. ``lambda label: TextProgress()``; one with a ``phase`` method, as
+    TextProgress has, also gets a line for the variant's metrics and time
+    series); ``log(text)`` gets one line per
     finished variant, ``notice(text)`` the takeover of a stale lock.
 
     The directory is locked while written (`pyins.records.lock_dir`: a
@@ -279,7 +318,8 @@ def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native"
                          KeyboardInterrupt() if held.interrupted else None)
     finally:
         if lock is not None:
-            lock.release()
+            with hold_interrupts():          # a second Ctrl-C must not leave the lock file behind
+                lock.release()
 
 
 def _start(scn, run_dir, resume, engine, force):
@@ -290,9 +330,10 @@ def _start(scn, run_dir, resume, engine, force):
     records.write_atomic(os.path.join(run_dir, "scenario.toml"), scn.text)
     records.write_atomic(os.path.join(run_dir, "resolved_scenario.json"), scn.resolved_json())
     specs = list(scn.runs())
+    written = written_durations(scn)
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
                    digest=scn.digest(), core_version=native.version(), paper=scn.paper,
-                   variants=[_entry(spec) for spec in specs], complete=False, state="running",
+                   variants=[_entry(spec, written) for spec in specs], complete=False, state="running",
                    scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name))
     if engine != "native":
         summary["engine"] = engine
@@ -316,13 +357,14 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
                 if os.path.exists(os.path.join(vdir, name)):
                     os.remove(os.path.join(vdir, name))
             checkpoint = int(round(CHECKPOINT_S / spec.dt))
+            bar = progress(spec.label) if progress else None
             run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
-                checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint),
-                progress=progress(spec.label) if progress else None)
-            res, info = load_variant(run_dir, spec)
-            mm = metrics.run_metrics(spec, res) if res is not None else {}
-            if res is not None and len(res.outputs):
-                records.write_timeseries(vdir, res)
+                checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint), progress=bar)
+            with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
+                res, info = load_variant(run_dir, spec)
+                mm = metrics.run_metrics(spec, res) if res is not None else {}
+                if res is not None and len(res.outputs):
+                    records.write_timeseries(vdir, res)
             entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
                          complete=bool(info and info.get("complete")), metrics=mm)
         except KeyboardInterrupt as exc:
@@ -355,25 +397,63 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
     return summary
 
 
+def span(seconds):
+    """A duration as a report writes it: 6 h, 12 min, 150 s."""
+    if seconds >= 3600:
+        return f"{seconds / 3600:.3g} h"
+    if seconds >= 60:
+        return f"{seconds / 60:.3g} min"
+    return f"{seconds:.3g} s"
+
+
+def not_judged(variants):
+    """Why the paper's figures cannot be judged on these summary entries
+    (one variant, or all of a group metric), or "" when they can: a variant
+    that stopped (its metrics cover part of the run), or one run for another
+    length than the scenario file gives it (``--hours``, ``--set duration``):
+    the paper's figures are for the run as written (a final error at 6 h is
+    not the error at 72 h, nor the largest over 6 h the largest over 72 h)."""
+    for v in variants:
+        dur = v.get("duration_s")
+        if not v.get("complete"):
+            if dur and v.get("ticks"):
+                return (f"not judged: the run stopped at {span(dur * v.get('ticks_done', 0) / v['ticks'])}"
+                        f" of {span(dur)}")
+            return "not judged: the run stopped before its end"
+        written = v.get("written_duration_s")
+        if dur is not None and written is not None and abs(dur - written) > 1e-6 * max(written, 1.0):
+            how = "shortened" if dur < written else "lengthened"
+            return (f"not judged: run {how} to {span(dur)}; the paper's figure is for the "
+                    f"{span(written)} the scenario runs")
+    return ""
+
+
 def paper_rows(summary):
-    """The paper's figures beside ours: (metric, variant, relation, paper value,
-    unit, our value in the paper's unit, verdict) for the report and the CLI."""
+    """The paper's figures beside ours, a dict per row: metric, variant,
+    relation, paper (value), unit, ours (our value in the paper's unit, None
+    if none), verdict ("within"/"above" a bound, "xR" the ratio to a value,
+    or "not judged: why" for a partial or re-timed run: `not_judged`),
+    judged (bool), note. For the report and the CLI."""
     rows = []
     paper = summary.get("paper") or {}
     for fig in paper.get("figures", []):
         metric = fig["metric"]
         targets = [v for v in summary["variants"] if fig.get("variant") in (None, v["label"])]
         if metric in summary.get("group_metrics", {}):
-            ours = [("all", summary["group_metrics"][metric])]
+            ours = [("all", summary["group_metrics"][metric], summary["variants"])]
         else:
-            ours = [(v["label"], v["metrics"].get(metric)) for v in targets]
-        for label, val in ours:
+            ours = [(v["label"], v["metrics"].get(metric), [v]) for v in targets]
+        for label, val, over in ours:
             mine = None if val is None else scenario.in_figure_unit(val, fig)
-            verdict = ""
-            if mine is not None and fig["relation"] == "<":
+            why = not_judged(over)
+            verdict = why
+            if why or mine is None:
+                pass
+            elif fig["relation"] == "<":
                 verdict = "within" if mine < fig["value"] else "above"
-            elif mine is not None and fig["value"]:
+            elif fig["value"]:
                 verdict = f"x{mine / fig['value']:.2f}"
             rows.append(dict(metric=metric, variant=label, relation=fig["relation"], paper=fig["value"],
-                             unit=fig["unit"], ours=mine, verdict=verdict, note=fig.get("note", "")))
+                             unit=fig["unit"], ours=mine, verdict=verdict, judged=not why and mine is not None,
+                             note=fig.get("note", "")))
     return rows

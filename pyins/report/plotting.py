@@ -1,13 +1,23 @@
-"""What every figure of pyins shares: matplotlib for files, and margins.
+"""What every figure of pyins shares: matplotlib for files, margins, the
+time axis, and the two things that keep a long run's figure readable and
+cheap: a min/max envelope of each curve (`envelope`: at most `MAX_POINTS`
+points a line, every peak kept) and the window of a few turntable cycles a
+zoom panel shows (`cycle_window`).
 
 matplotlib is imported when a figure is first drawn (not with pyins), on its
 Agg backend: files only, no display.
 """
 import math
 
+import numpy as np
+
 from pyins.units import UNITS
 
-__all__ = ["pyplot", "margins", "time_axis"]
+__all__ = ["pyplot", "margins", "time_axis", "envelope", "cycle_window", "MAX_POINTS"]
+
+#: at most this many points per plotted line: a 72 h run at 1 Hz has 259,200
+#: records, and a figure is 800-1100 px wide
+MAX_POINTS = 4000
 
 
 def pyplot():
@@ -39,3 +49,49 @@ def time_axis(t_s):
     if span > 20 * UNITS["time"]["min"]:
         return t_s / UNITS["time"]["min"], "time [min]"
     return t_s, "time [s]"
+
+
+def envelope(x, y, max_points=MAX_POINTS):
+    """(x, y) of one curve with at most ``max_points`` points: the samples
+    split into equal buckets, the smallest and the largest of each kept in
+    their order (and the first and last sample), so the line drawn through
+    them covers what the whole curve covers at any width the figure has.
+    A stride would alias: a 120 s rotation cycle sampled every 65 s draws a
+    slow wave that is not there. NaN samples are skipped within a bucket."""
+    x, y = np.asarray(x), np.asarray(y, dtype=float)
+    n = len(y)
+    if n <= max_points:
+        return x, y
+    m = max(1, max_points // 2 - 2)            # buckets of k samples; 2 per bucket + the ends + a tail
+    k = -(-n // m)
+    m = n // k
+    blk = y[:m * k].reshape(m, k)
+    nan = np.isnan(blk)
+    lo = np.argmin(np.where(nan, np.inf, blk), axis=1)
+    hi = np.argmax(np.where(nan, -np.inf, blk), axis=1)
+    base = np.arange(m) * k
+    parts = [base + lo, base + hi, [0, n - 1]]
+    if m * k < n:
+        tail = y[m * k:]
+        parts.append(m * k + np.array([np.nanargmin(tail), np.nanargmax(tail)]
+                                      if not np.isnan(tail).all() else [0]))
+    idx = np.unique(np.concatenate(parts).astype(np.int64))
+    return x[idx], y[idx]
+
+
+def cycle_window(index_step, index_state, cycles=3, min_cycles=8):
+    """The record slice of ``cycles`` turntable cycles (from the first
+    stop-or-move change on), for a zoom panel; None when the run has fewer
+    than ``min_cycles`` (the whole run then reads without one). A cycle is
+    every step of the scheme once (``index_step`` 0..n-1), each a stop and a
+    move: 2 n changes of ``index_state``."""
+    index_state = np.asarray(index_state)
+    n_steps = int(np.max(index_step)) + 1 if len(index_step) else 1
+    changes = np.flatnonzero(np.diff(index_state) != 0) + 1
+    per_cycle = 2 * n_steps
+    if len(changes) < min_cycles * per_cycle:
+        return None
+    start = changes[0]
+    stop = changes[cycles * per_cycle]
+    margin = max(1, (stop - start) // 40)
+    return slice(max(0, start - margin), min(len(index_state), stop + margin))

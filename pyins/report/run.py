@@ -4,15 +4,30 @@ Reads only what `pyins.runs.execute` wrote (summary.json, the variants'
 timeseries.npz), so a report can be re-rendered, or rendered for a partial
 run, without running anything. Units follow the papers (`pyins.metrics`):
 position errors in m or nmi (whichever reads better), level errors in
-arc-seconds, heading errors in arc-minutes.
+arc-seconds, heading errors in arc-minutes, latitude and longitude errors
+in arc-seconds or, with errors beyond a minute, arc-minutes (1' of
+latitude is 1 nmi).
 
 `render`:
-1. the figures: navigation errors, the alignment's convergence, the
-   turntable and the flexible scheme's sums, the scheme comparison (each
-   when the run has something to show);
-2. the results table (a column per metric a paper figure may name), the
-   group metrics and the paper's figures beside ours;
+1. the figures, each only where it means something: the errors (position:
+   horizontal, north, east, latitude, longitude; velocity, when a variant
+   navigates: an alignment holds the site; level, heading);
+   the alignment's convergence (runs that align); the turntable (rotating
+   variants), with a zoom on a few cycles beside each panel when the run has
+   many, and the flexible sums A_c, A_s (only schemes that steer by them);
+   the scheme comparison (two variants or more). Every curve is a min/max
+   envelope of at most `pyins.report.plotting.MAX_POINTS` points: a 72 h run
+   draws in seconds and its peaks stay;
+2. the results table, a row per metric and a column per variant (at most
+   `VARIANTS_PER_TABLE` a table: the page reads at 1200 px whatever the
+   number of metrics), the position error split north/east and
+   latitude/longitude, the group metrics, the paper's figures beside ours
+   (`pyins.runs.paper_rows`: a stopped run, or one run for another length
+   than the scenario gives it, is labelled and not judged);
 3. report.html, with the scenario as run.
+
+``render(..., progress=pyins.progress.Phases())`` writes a line per phase
+(reading the records, the figures) on stderr.
 """
 import html
 import json
@@ -22,10 +37,32 @@ import numpy as np
 
 from pyins import metrics, records, runs
 from pyins.metrics import FIGURE_METRICS, display
-from pyins.report.plotting import pyplot, time_axis
+from pyins.progress import phase
+from pyins.reference import abi, earth
+from pyins.report.plotting import cycle_window, envelope, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
 
-__all__ = ["render", "load", "plot_errors", "plot_alignment", "plot_table", "plot_comparison"]
+__all__ = ["render", "load", "plot_errors", "plot_alignment", "plot_table", "plot_comparison",
+           "latlon_errors", "navigates", "VARIANTS_PER_TABLE"]
+
+#: variant columns of one results table (more variants: more tables, one under the other)
+VARIANTS_PER_TABLE = 5
+_DPI = 90
+
+
+def _fill_facts(run_dir, summary, scn):
+    """Duration as run and as written, and the use of the flexible sums, for
+    the variants of a summary written before `pyins.runs` recorded them."""
+    if all("duration_s" in v and "uses_index_sums" in v for v in summary["variants"]):
+        return
+    scn = scn if scn is not None else runs.scenario_of(run_dir, summary)
+    if scn is None:
+        return
+    written = runs.written_durations(scn)
+    facts = {spec.label: runs.variant_facts(spec, written) for spec in scn.runs()}
+    for v in summary["variants"]:
+        for k, val in facts.get(v["label"], {}).items():
+            v.setdefault(k, val)
 
 
 def load(run_dir):
@@ -40,6 +77,7 @@ def load(run_dir):
     unfinished = [v for v in summary["variants"] if not v.get("complete")]
     scn = runs.scenario_of(run_dir, summary) if unfinished else None
     specs = {spec.label: spec for spec in scn.runs()} if scn is not None else {}
+    _fill_facts(run_dir, summary, scn)
     series = {}
     for v in summary["variants"]:
         path = os.path.join(run_dir, v["dir"], "timeseries.npz")
@@ -69,48 +107,127 @@ def load(run_dir):
     return summary, series
 
 
-def plot_errors(summary, series, path):
-    plt = pyplot()
-    big = max((s["horizontal_m"].max() for s in series.values() if len(s["horizontal_m"])), default=0)
-    pos_scale, pos_unit = (NMI_TO_M, "nmi") if big > 0.5 * NMI_TO_M else (1.0, "m")
-    fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
-    for label, s in series.items():
-        t, tl = time_axis(s["time_s"])
-        ax[0].plot(t, s["horizontal_m"] / pos_scale, label=label)
-        ax[1].plot(t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, label=label)
-        ax[2].plot(t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, label=label)
-        ax[3].plot(t, np.hypot(s["vel_err_n_mps"][:, 0], s["vel_err_n_mps"][:, 1]), label=label)
-        ax[3].set_xlabel(tl)
-    for a, yl in zip(ax, [f"horizontal position error [{pos_unit}]", "max |level error| [arcsec]",
-                          "heading error phi_U [arcmin]", "horizontal velocity error [m/s]"]):
-        a.set_ylabel(yl)
-        a.grid(alpha=0.3)
-        if len(series) > 1:
-            a.legend(fontsize=8)
-    fig.suptitle(summary["title"], fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
+# ---------------------------------------------------------------------------
+# 1. The figures
+# ---------------------------------------------------------------------------
+def latlon_errors(s):
+    """(latitude error, longitude error) [rad] of one variant's series: its
+    north and east errors over the radii of curvature at the computed
+    position (to 1e-4 of the value, what a figure or a table shows)."""
+    o = s["outputs"]
+    rm, rn = earth.principal_radii(np.sin(o["lat_rad"]))
+    h = o["height_m"]
+    return s["north_m"] / (rm + h), s["east_m"] / ((rn + h) * np.cos(o["lat_rad"]))
+
+
+def _pos_unit(values_m):
+    return display("horizontal_error_max", [float(np.max(np.abs(v), initial=0.0)) for v in values_m])
+
+
+def _angle_unit(values_rad):
+    big = max((float(np.max(np.abs(v), initial=0.0)) for v in values_rad), default=0.0)
+    return ("arcmin", ARCMIN_TO_RAD) if big > ARCMIN_TO_RAD else ("arcsec", ARCSEC_TO_RAD)
+
+
+def _line(ax, t, y, *args, log=False, **kw):
+    """One curve, as its min/max envelope (`pyins.report.plotting.envelope`)."""
+    x, y = envelope(t, y)
+    return (ax.semilogy if log else ax.plot)(x, y, *args, **kw)
+
+
+def _clock(series):
+    """(seconds per unit, axis label) of one time axis for every variant of a
+    figure: the unit `time_axis` picks for the longest of them (a stopped
+    variant is drawn on the same axis as the finished ones)."""
+    span = max((float(s["time_s"][-1]) for s in series.values() if len(s["time_s"])), default=0.0)
+    shown, label = time_axis(np.array([span]))
+    return (span / shown[0] if span > 0 else 1.0), label
+
+
+def _colours(summary):
+    """label -> colour: one per variant, the same in every figure."""
+    return {v["label"]: f"C{i % 10}" for i, v in enumerate(summary["variants"])}
+
+
+def _save(fig, path, plt):
+    fig.savefig(path, dpi=_DPI)
     plt.close(fig)
+
+
+def navigates(s):
+    """True when a variant's series holds navigation (more than the last
+    record in PYINS_MODE_NAVIGATE): during an alignment the firmware holds
+    the site and zero velocity, so position and velocity errors mean
+    nothing."""
+    return int(np.count_nonzero(s["outputs"]["mode"] == abi.PYINS_MODE_NAVIGATE)) > 1
+
+
+def plot_errors(summary, series, path):
+    """Horizontal, north and east position errors, latitude and longitude
+    errors, horizontal velocity (when a variant navigates), level and heading
+    errors of every variant."""
+    plt = pyplot()
+    nav = any(navigates(s) for s in series.values())
+    rows = 4 if nav else 1
+    fig, ax = plt.subplots(rows, 2, figsize=(12.4, 11 if nav else 3.6), sharex=True, squeeze=False)
+    ts, tl = _clock(series)
+    colour = _colours(summary)
+    if nav:
+        pos_unit, pos_scale = _pos_unit([s[k] for s in series.values() for k in ("north_m", "east_m",
+                                                                                "horizontal_m")])
+        ll = {label: latlon_errors(s) for label, s in series.items()}
+        ang_unit, ang_scale = _angle_unit([a for pair in ll.values() for a in pair])
+    for label, s in series.items():
+        t = s["time_s"] / ts
+        kw = dict(label=label, lw=0.9, color=colour[label])
+        if nav:
+            dlat, dlon = ll[label]
+            _line(ax[0, 0], t, s["horizontal_m"] / pos_scale, **kw)
+            _line(ax[0, 1], t, np.hypot(s["vel_err_n_mps"][:, 0], s["vel_err_n_mps"][:, 1]), **kw)
+            _line(ax[1, 0], t, s["north_m"] / pos_scale, **kw)
+            _line(ax[1, 1], t, s["east_m"] / pos_scale, **kw)
+            _line(ax[2, 0], t, dlat / ang_scale, **kw)
+            _line(ax[2, 1], t, dlon / ang_scale, **kw)
+        _line(ax[-1, 0], t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, **kw)
+        _line(ax[-1, 1], t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, **kw)
+    for a in ax[-1]:
+        a.set_xlabel(tl)
+    names = ([f"horizontal position error [{pos_unit}]", "horizontal velocity error [m/s]",
+              f"north position error [{pos_unit}]", f"east position error [{pos_unit}]",
+              f"latitude error [{ang_unit}]", f"longitude error [{ang_unit}]"] if nav else [])
+    names += ["max |level error| [arcsec]", "heading error phi_U [arcmin]"]
+    for a, yl in zip(ax.flat, names):
+        a.set_ylabel(yl, fontsize=9)
+        a.grid(alpha=0.3)
+    if len(series) > 1:
+        ax[0, 0].legend(fontsize=8)
+    fig.suptitle(summary["title"] + ("" if nav else " (alignment only: the site and zero velocity are "
+                                     "held, no position error to show)"), fontsize=10)
+    fig.tight_layout()
+    _save(fig, path, plt)
 
 
 def plot_alignment(summary, series, path):
     """Attitude errors and the filter's sigma over the alignment (if any)."""
-    plt = pyplot()
     aligning = {k: s for k, s in series.items() if (s["outputs"]["mode"] != 3).any()}
     if not aligning:
         return False
-    fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    plt = pyplot()
+    fig, ax = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
     names = ["phi_E [arcsec]", "phi_N [arcsec]", "phi_U [arcmin]"]
     scale = [ARCSEC_TO_RAD, ARCSEC_TO_RAD, ARCMIN_TO_RAD]
+    ts, tl = _clock(aligning)
+    colour = _colours(summary)
     for label, s in aligning.items():
-        t, tl = time_axis(s["time_s"])
+        t = s["time_s"] / ts
         for i in range(3):
             # |error| on a log axis: the first seconds are degrees, the end arc-seconds
-            ax[i].semilogy(t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9)
+            _line(ax[i], t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9, log=True,
+                  color=colour[label])
             sig = s["outputs"]["kf_sigma"][:, i]
             if np.any(sig > 0):
-                ax[i].semilogy(t, 3 * sig / scale[i], "k:", lw=0.8)
-        ax[2].set_xlabel(tl)
+                _line(ax[i], t, 3 * sig / scale[i], "k:", lw=0.8, log=True)
+    ax[2].set_xlabel(tl)
     for a, n in zip(ax, names):
         a.set_ylabel(f"|{n.split(' ')[0]}| {n.split(' ')[1]}")
         a.grid(alpha=0.3, which="both")
@@ -118,48 +235,87 @@ def plot_alignment(summary, series, path):
     ax[0].set_title("alignment convergence: |attitude error| (dotted: 3 sigma of the fine-alignment "
                     "filter)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _save(fig, path, plt)
     return True
 
 
+def _zoom_axis(t0_s, t1_s):
+    """Unit and label of a zoom panel's time axis: seconds up to 20 min, else minutes."""
+    return (60.0, "time [min]") if t1_s - t0_s > 1200 else (1.0, "time [s]")
+
+
 def plot_table(summary, series, path):
-    """Table angle, IMU heading and A_c/A_s of the rotating variants."""
-    plt = pyplot()
+    """Table angle and IMU yaw of the rotating variants, and the flexible
+    sums A_c, A_s of those whose scheme steers by them; beside each panel a
+    zoom on a few cycles when the run holds many (a 24 h run at 120 s a
+    cycle is otherwise a solid band). False when no variant rotates."""
     turning = {k: s for k, s in series.items()
                if np.any(s["outputs"]["index_state"] != 0) or np.any(s["outputs"]["table_angle_rad"] != 0)}
     if not turning:
         return False
-    fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    plt = pyplot()
+    flexible = {v["label"] for v in summary["variants"] if v.get("uses_index_sums")}
+    sums = {k: s for k, s in turning.items() if k in flexible}
+    windows = {}
+    for label, s in turning.items():
+        w = cycle_window(s["outputs"]["index_step"], s["outputs"]["index_state"])
+        if w is not None:
+            windows[label] = (s["time_s"][w.start], s["time_s"][w.stop - 1])
+    zoom = (min(a for a, _ in windows.values()), max(b for _, b in windows.values())) if windows else None
+    rows = 3 if sums else 2
+    fig = plt.figure(figsize=(12.4, 3.1 * rows))
+    gs = fig.add_gridspec(rows, 2 if zoom else 1, width_ratios=[2.3, 1] if zoom else [1])
+    main = [fig.add_subplot(gs[0, 0])]
+    main += [fig.add_subplot(gs[i, 0], sharex=main[0]) for i in range(1, rows)]
+    side = []
+    if zoom:
+        side = [fig.add_subplot(gs[0, 1])]
+        side += [fig.add_subplot(gs[i, 1], sharex=side[0]) for i in range(1, rows)]
+        zs, zl = _zoom_axis(*zoom)
+    ts, tl = _clock(turning)
+    colour = _colours(summary)
     for label, s in turning.items():
         o = s["outputs"]
-        t, tl = time_axis(s["time_s"])
-        ax[0].plot(t, np.degrees(o["table_angle_rad"]), label=label, lw=0.8)
-        ax[1].plot(t, np.degrees(o["yaw_p_rad"]), label=label, lw=0.5)
-        ax[2].plot(t, o["index_a_c"], label=f"{label}: A_c", lw=0.8)
-        ax[2].plot(t, o["index_a_s"], "--", label=f"{label}: A_s", lw=0.8)
-        ax[2].set_xlabel(tl)
-    for a, yl in zip(ax, ["table angle (encoder) [deg]", "IMU yaw psi_p [deg]",
-                          "A_c, A_s [samples]"]):
-        a.set_ylabel(yl)
+        t = s["time_s"] / ts
+        curves = [(0, np.degrees(o["table_angle_rad"]), "-", label), (1, np.degrees(o["yaw_p_rad"]), "-", label)]
+        if label in sums:
+            curves += [(2, o["index_a_c"], "-", f"{label}: A_c"), (2, o["index_a_s"], "--", f"{label}: A_s")]
+        for row, y, style, name in curves:
+            _line(main[row], t, y, style, label=name, lw=0.7, color=colour[label])
+            if zoom:
+                k = (s["time_s"] >= zoom[0]) & (s["time_s"] <= zoom[1])
+                _line(side[row], s["time_s"][k] / zs, y[k], style, color=colour[label], lw=0.9)
+    names = ["table angle (encoder) [deg]", "IMU yaw psi_p [deg]", "A_c, A_s [samples]"]
+    for a, yl in zip(main, names):
+        a.set_ylabel(yl, fontsize=9)
         a.grid(alpha=0.3)
-        a.legend(fontsize=7)
+        a.legend(fontsize=7, loc="upper right")
+        if zoom:
+            a.axvspan(zoom[0] / ts, zoom[1] / ts, color="0.8", lw=0, zorder=0)
+    main[-1].set_xlabel(tl)
+    main[0].set_title("the whole run" + (" (shaded: the zoom at the right)" if zoom else ""), fontsize=9)
+    if sums and len(sums) < len(turning):
+        main[2].set_title("A_c, A_s: only the schemes that steer by them", fontsize=9)
+    for a in side:
+        a.grid(alpha=0.3)
+    if zoom:
+        side[-1].set_xlabel(zl)
+        side[0].set_title("zoom: a few cycles", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _save(fig, path, plt)
     return True
 
 
 def plot_comparison(summary, path):
     """Final and maximum horizontal errors per variant, the paper's beside."""
-    plt = pyplot()
     vs = [v for v in summary["variants"] if "horizontal_error_max" in v["metrics"]]
     if len(vs) < 2:
         return False
+    plt = pyplot()
     big = max(v["metrics"]["horizontal_error_max"] for v in vs)
     sc, un = (NMI_TO_M, "nmi") if big > 0.5 * NMI_TO_M else (1.0, "m")
     x = np.arange(len(vs))
-    fig, ax = plt.subplots(figsize=(9, 4.5))
+    fig, ax = plt.subplots(figsize=(10, 4.5))
     ax.bar(x - 0.25, [v["metrics"]["horizontal_error_final"] / sc for v in vs], 0.25, label="ours, final")
     ax.bar(x, [v["metrics"]["horizontal_error_max"] / sc for v in vs], 0.25, label="ours, max")
     paper = {}
@@ -167,92 +323,192 @@ def plot_comparison(summary, path):
         if f["metric"].startswith("horizontal_error") and f.get("variant"):
             paper[f["variant"]] = f["value_si"] / sc
     if paper:
-        ax.bar(x + 0.25, [paper.get(v["label"], 0.0) for v in vs], 0.25, label="paper")
+        caveat = runs.not_judged([v for v in vs if v["label"] in paper])
+        ax.bar(x + 0.25, [paper.get(v["label"], 0.0) for v in vs], 0.25,
+               label="paper" + (" (for the full-length run: not comparable)" if caveat else ""))
     ax.set_xticks(x, [v["label"] for v in vs], fontsize=8, rotation=10)
     ax.set_ylabel(f"horizontal position error [{un}]")
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _save(fig, path, plt)
     return True
 
 
-def _fmt(v, unit_scale):
-    unit, scale = unit_scale
-    return f"{v / scale:.4g} {unit}"
+# ---------------------------------------------------------------------------
+# 2. The tables
+# ---------------------------------------------------------------------------
+esc = html.escape
 
 
 def _ours(row):
     return "" if row["ours"] is None else f"{row['ours']:.4g} {row['unit']}"
 
 
-def render(run_dir, loaded=None):
-    """Write the plots and report.html into ``run_dir``; returns the path.
-    ``loaded``: what `load` returned for it (else it is read here)."""
-    summary, series = loaded if loaded is not None else load(run_dir)
-    # 1. the figures
-    figs = []
-    if series:
-        plot_errors(summary, series, os.path.join(run_dir, "errors.png"))
-        figs.append(("errors.png", "Navigation errors against the truth"))
-        if plot_alignment(summary, series, os.path.join(run_dir, "alignment.png")):
-            figs.append(("alignment.png", "Alignment convergence"))
-        if plot_table(summary, series, os.path.join(run_dir, "table.png")):
-            figs.append(("table.png", "Turntable angle, IMU heading and the flexible scheme's sums"))
-    if plot_comparison(summary, os.path.join(run_dir, "comparison.png")):
-        figs.append(("comparison.png", "Scheme comparison"))
-    # 2. the results, the group metrics, the paper's figures
-    esc = html.escape
-    metric_names = [k for k in FIGURE_METRICS if any(k in v["metrics"] for v in summary["variants"])]
-    head = "".join(f"<th>{esc(k)}</th>" for k in metric_names)
-    body = []
-    for v in summary["variants"]:
-        cells = "".join(f"<td>{_fmt(v['metrics'][k], display(k)) if k in v['metrics'] else ''}</td>"
-                        for k in metric_names)
-        done = "" if v["complete"] else f" (partial: {v['ticks_done']} of {v['ticks']} ticks)"
-        body.append(f"<tr><td>{esc(v['label'])}{esc(done)}</td>{cells}</tr>")
-    group = "".join(f"<li>{esc(k)}: {_fmt(val, display(k))}</li>"
-                    for k, val in summary.get("group_metrics", {}).items())
+def _status(v):
+    dur = v.get("duration_s")
+    if not v.get("complete"):
+        done = (f"{runs.span(dur * v.get('ticks_done', 0) / v['ticks'])} of {runs.span(dur)}"
+                if dur and v.get("ticks") else f"{v.get('ticks_done', 0)} of {v['ticks']} ticks")
+        return f"partial: {done}"
+    written = v.get("written_duration_s")
+    if dur is not None and written is not None and runs.not_judged([v]):
+        return f"{runs.span(dur)} (the scenario: {runs.span(written)})"
+    return f"complete, {runs.span(dur)}" if dur else "complete"
+
+
+def _component_rows(summary, series):
+    """Rows (name, description, {label: cell}) of the position error split
+    north/east and latitude/longitude: "final / largest |.|"."""
+    have = [v["label"] for v in summary["variants"] if v["label"] in series and navigates(series[v["label"]])]
+    if not have:
+        return []
+    ll = {k: latlon_errors(series[k]) for k in have}
+    pu, ps = _pos_unit([series[k][c] for k in have for c in ("north_m", "east_m")])
+    au, ascale = _angle_unit([a for k in have for a in ll[k]])
+
+    def cell(y, scale, unit):
+        return f"{y[-1] / scale:.4g} / {np.abs(y).max() / scale:.4g} {unit}" if len(y) else ""
+    return [
+        ("north error", "north position error: final / largest |value|",
+         {k: cell(series[k]["north_m"], ps, pu) for k in have}),
+        ("east error", "east position error: final / largest |value|",
+         {k: cell(series[k]["east_m"], ps, pu) for k in have}),
+        ("latitude error", "latitude error: final / largest |value| (1 arcmin of latitude = 1 nmi)",
+         {k: cell(ll[k][0], ascale, au) for k in have}),
+        ("longitude error", "longitude error: final / largest |value|",
+         {k: cell(ll[k][1], ascale, au) for k in have}),
+    ]
+
+
+def _results_tables(summary, series):
+    """The results: a row per metric, a column per variant, at most
+    VARIANTS_PER_TABLE variants a table."""
+    variants = summary["variants"]
+    metric_names = [k for k in FIGURE_METRICS if any(k in v["metrics"] for v in variants)]
+    rows = []
+    for k in metric_names:
+        unit = display(k, [v["metrics"].get(k) for v in variants])
+        rows.append((k, metrics.describe(k),
+                     {v["label"]: f"{v['metrics'][k] / unit[1]:.4g} {unit[0]}" for v in variants
+                      if k in v["metrics"]}))
+    rows += _component_rows(summary, series)
+    out = []
+    for i in range(0, len(variants), VARIANTS_PER_TABLE):
+        part = variants[i:i + VARIANTS_PER_TABLE]
+        cols = f"<col class='name'>{'<col>' * len(part)}"
+        head = "".join(f"<th>{esc(v['label'])}</th>" for v in part)
+        status = "".join(f"<td>{esc(_status(v))}</td>" for v in part)
+        body = "".join(f"<tr><td title='{esc(desc, quote=True)}'><code>{esc(name)}</code></td>"
+                       + "".join(f"<td>{esc(cells.get(v['label'], ''))}</td>" for v in part) + "</tr>"
+                       for name, desc, cells in rows)
+        out.append(f"<table class='fit results'><colgroup>{cols}</colgroup>"
+                   f"<tr><th>metric</th>{head}</tr><tr class='status'><td>run</td>{status}</tr>{body}</table>")
+    return "\n".join(out)
+
+
+def _caveats(summary):
+    """Sentences on a run that is not the scenario as written: stopped, or
+    run for another length (what the paper's figures then cannot be judged on)."""
+    out = []
+    if not summary["complete"]:
+        out.append(f"PARTIAL ({summary.get('stopped', 'interrupted')}): the figures and tables cover the "
+                   "ticks done; the paper's figures are not judged on a stopped variant.")
+    retimed = [v for v in summary["variants"] if v.get("complete") and runs.not_judged([v])]
+    if retimed:
+        v = retimed[0]
+        out.append(f"Run for {runs.span(v['duration_s'])}; the scenario as written runs "
+                   f"{runs.span(v['written_duration_s'])}, the length its paper's figures are for: they are "
+                   "shown beside ours and not judged.")
+    return out
+
+
+def _paper_html(summary):
     paper = summary.get("paper") or {}
+    if not (paper.get("figures") or paper.get("citation")):
+        return ""
     prow = "".join(
         f"<tr><td>{esc(r['metric'])}</td><td>{esc(r['variant'] or '')}</td>"
         f"<td>{esc(r['relation'])} {r['paper']:g} {esc(r['unit'])}</td>"
-        f"<td>{esc(_ours(r))}</td><td>{esc(r['verdict'])}</td><td>{esc(r['note'])}</td></tr>"
+        f"<td>{esc(_ours(r))}</td><td class='{'verdict' if r['judged'] else 'unjudged'}'>{esc(r['verdict'])}</td>"
+        f"<td class='note'>{esc(r['note'])}</td></tr>"
         for r in runs.paper_rows(summary))
-    paper_html = ""
-    if paper.get("figures") or paper.get("citation"):
-        paper_html = (f"<h2>Beside the paper</h2><p>{esc(paper.get('citation', ''))}</p>"
-                      f"<p class='note'>{esc(paper.get('note', ''))}</p>"
-                      "<table><tr><th>metric</th><th>variant</th><th>paper</th><th>ours</th>"
-                      f"<th>verdict</th><th>note</th></tr>{prow}</table>")
+    cols = "".join(f"<col style='width: {w}%'>" for w in (15, 13, 9, 10, 15, 38))
+    return (f"<h2>Beside the paper</h2><p>{esc(paper.get('citation', ''))}</p>"
+            f"<p class='note'>{esc(paper.get('note', ''))}</p>"
+            f"<table class='fit paper'><colgroup>{cols}</colgroup>"
+            "<tr><th>metric</th><th>variant</th><th>paper</th><th>ours</th>"
+            f"<th>verdict</th><th>note</th></tr>{prow}</table>")
+
+
+#: the page's style: at most 1360 px wide, every table as wide as the page
+#: with fixed columns whose text wraps, images scaled down: nothing scrolls
+#: sideways at 1200-1400 px (tests/cli/test_report_layout.py)
+STYLE = """
+body { font-family: sans-serif; max-width: 1360px; margin: 1.5em auto; padding: 0 1em; color: #222; }
+table.fit { width: 100%; table-layout: fixed; border-collapse: collapse; margin: 1em 0; font-size: 0.88em; }
+table.results col.name { width: 16em; }
+td, th { border: 1px solid #bbb; padding: 0.25em 0.5em; text-align: right; vertical-align: top;
+         overflow-wrap: anywhere; }
+td:first-child, th:first-child, table.paper td, table.paper th { text-align: left; }
+table.paper td:nth-child(3), table.paper td:nth-child(4) { text-align: right; }
+tr.status td { color: #555; font-size: 0.92em; }
+td.unjudged { color: #8a5a00; }
+.caveat { background: #fff4d6; border-left: 4px solid #e0a800; padding: 0.4em 0.8em; }
+figure { margin: 1em 0; } img { max-width: 100%; height: auto; }
+.note { color: #555; white-space: pre-wrap; }
+pre { background: #f4f4f4; padding: 1em; white-space: pre-wrap; overflow-wrap: anywhere; }
+"""
+
+
+def render(run_dir, loaded=None, progress=None):
+    """Write the plots and report.html into ``run_dir``; returns the path.
+    ``loaded``: what `load` returned for it (else it is read here);
+    ``progress``: a `pyins.progress.Phases` (a line per phase), or None."""
+    if loaded is None:
+        with phase(progress, "report: reading the records"):
+            loaded = load(run_dir)
+    summary, series = loaded
+    # 1. the figures
+    figs = []
+    plots = [("errors.png", "Errors against the truth", lambda p: plot_errors(summary, series, p) or True),
+             ("alignment.png", "Alignment convergence", lambda p: plot_alignment(summary, series, p)),
+             ("table.png", "Turntable angle and IMU heading (zoom: a few cycles)"
+              + (", the flexible scheme's sums A_c, A_s" if any(v.get("uses_index_sums") for v in summary["variants"])
+                 else ""), lambda p: plot_table(summary, series, p))] if series else []
+    plots.append(("comparison.png", "Scheme comparison", lambda p: plot_comparison(summary, p)))
+    with phase(progress, "report: figures"):
+        for name, caption, draw in plots:
+            path = os.path.join(run_dir, name)
+            if draw(path):
+                figs.append((name, caption))
+            elif os.path.exists(path):          # an older rendering's figure that no longer means anything
+                os.remove(path)
+    # 2. the results, the group metrics, the paper's figures
+    group = "".join(f"<li>{esc(k)}: {val / display(k)[1]:.4g} {display(k)[0]}</li>"
+                    for k, val in summary.get("group_metrics", {}).items())
     # 3. the page
     scen_text = ""
     scen_path = os.path.join(run_dir, "scenario.toml")
     if os.path.exists(scen_path):
         with open(scen_path) as f:
             scen_text = f.read()
-    status = "complete" if summary["complete"] else (
-        f"PARTIAL ({summary.get('stopped', 'interrupted')}): figures cover the ticks done")
+    status = "complete" if summary["complete"] else f"PARTIAL ({summary.get('stopped', 'interrupted')})"
+    caveats = "".join(f"<p class='caveat'>{esc(c)}</p>" for c in _caveats(summary))
     imgs = "".join(f"<figure><img src='{esc(p)}' alt='{esc(c)}'><figcaption>{esc(c)}</figcaption></figure>"
                    for p, c in figs)
     page = f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{esc(summary['title'])}</title>
-<style>
-body {{ font-family: sans-serif; max-width: 1100px; margin: 2em auto; color: #222; }}
-table {{ border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }}
-td, th {{ border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }}
-td:first-child, th:first-child {{ text-align: left; }}
-figure {{ margin: 1em 0; }} img {{ max-width: 100%; }}
-.note {{ color: #555; white-space: pre-wrap; }} pre {{ background: #f4f4f4; padding: 1em; overflow-x: auto; }}
-</style></head><body>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{esc(summary['title'])}</title>
+<style>{STYLE}</style></head><body>
 <h1>{esc(summary['title'])}</h1>
 <p>Scenario <code>{esc(summary['scenario'])}</code>, digest <code>{esc(summary['digest'][:16])}</code>,
 core {esc(summary['core_version'])}. Status: {esc(status)}.</p>
+{caveats}
 <h2>Results</h2>
-<table><tr><th>variant</th>{head}</tr>{''.join(body)}</table>
+{_results_tables(summary, series)}
 {f'<ul>{group}</ul>' if group else ''}
-{paper_html}
+{_paper_html(summary)}
 <h2>Figures</h2>
 {imgs}
 <h2>Scenario</h2>
