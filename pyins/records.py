@@ -140,6 +140,19 @@ class DirLock:
         self.release()
 
 
+def drop_stale_lock(directory):
+    """Remove ``directory``'s lock file if the process that held it is gone
+    (a pool worker killed mid-run, or cut short in its release by a second
+    Ctrl-C); leave a live holder's. True if a stale lock was removed."""
+    if not os.path.exists(os.path.join(directory, LOCK)):
+        return False
+    try:
+        lock_dir(directory).release()       # takes the stale lock over, then removes it
+    except LockedError:
+        return False
+    return True
+
+
 def lock_dir(directory, what="run directory", notice=None):
     """Lock ``directory`` (made if missing) for this process: LockedError
     naming the holder (pid, host, start time) if a live process holds it. A

@@ -38,6 +38,7 @@ import os
 import signal
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 
 from pyins import records, runs
 from pyins import scenario as scenario_mod
@@ -218,16 +219,21 @@ def _stop_pool(ex, running, on_done, on_stopped):
             except OSError:
                 pass
         _, left = wait(left, timeout=STOP_GRACE_S[1])
-    for f, t in running.items():
-        exc = None if f.cancelled() or not f.done() else f.exception()
-        if f.done() and not f.cancelled() and not isinstance(exc, KeyboardInterrupt):
-            on_done(t, None if exc else f.result(), exc)
-        else:
-            on_stopped(t)
     if left:
         for proc in list((getattr(ex, "_processes", None) or {}).values()):
             proc.kill()
+            proc.join(timeout=5.0)
     ex.shutdown(wait=not left, cancel_futures=True)
+    # told after the workers are gone, so that what is on disk is final: a run
+    # that finished as the Ctrl-C came counts as computed (on_stopped reads its
+    # summary), and a worker killed in its run leaves no stale lock behind
+    for f, t in running.items():
+        exc = None if f.cancelled() or not f.done() else f.exception()
+        if f.done() and not f.cancelled() and not isinstance(exc, (KeyboardInterrupt, BrokenProcessPool)):
+            on_done(t, None if exc else f.result(), exc)
+        else:                       # stopped, or its worker killed (the pool is then broken)
+            on_stopped(t)
+        records.drop_stale_lock(t["run_dir"])
 
 
 def _run_dask(tasks, scheduler, on_done, on_stopped):
