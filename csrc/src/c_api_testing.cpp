@@ -155,7 +155,6 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
                                    : pyins::strapdown::Vertical::kHold;
     sd.ref_height = s->ref_height;
     sd.ref_lon = s->lon;
-    sd.site = pyins::strapdown::site_at(s->lat, s->height);  // a state handed in: its own site
     pyins::strapdown::update(sd, v3(dtheta_p), v3(dv_p), dt);
     s->lat = sd.nav.lat;
     s->lon = sd.nav.lon;

@@ -21,37 +21,19 @@ double normal_gravity(double sin_lat, double height) {
     return gamma0 * (1.0 - c1 * height + c2 * height * height);
 }
 
-Site site_of(double lat, double sin_lat, double cos_lat, double height) {
+Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n) {
     const PrincipalRadii r = principal_radii(sin_lat);
-    Site st;
-    st.lat = lat;
-    st.height = height;
-    st.sin_lat = sin_lat;
-    st.cos_lat = cos_lat;
-    st.rm_h = r.rm + height;
-    st.rn_h = r.rn + height;
-    st.tan_lat = sin_lat / cos_lat;
-    st.omega_ie_n = Vec3(0.0, kOmegaIe * cos_lat, kOmegaIe * sin_lat);
-    st.gravity_n = Vec3(0.0, 0.0, -normal_gravity(sin_lat, height));
-    return st;
-}
-
-Earth earth_with(const Site& st, const Vec3& vel_n) {
     Earth e;
-    e.sin_lat = st.sin_lat;
-    e.cos_lat = st.cos_lat;
-    e.rm_h = st.rm_h;
-    e.rn_h = st.rn_h;
-    e.tan_lat = st.tan_lat;
-    e.omega_ie_n = st.omega_ie_n;
+    e.sin_lat = sin_lat;
+    e.cos_lat = cos_lat;
+    e.rm_h = r.rm + height;
+    e.rn_h = r.rn + height;
+    e.tan_lat = sin_lat / cos_lat;
+    e.omega_ie_n = Vec3(0.0, kOmegaIe * cos_lat, kOmegaIe * sin_lat);
     e.omega_en_n = Vec3(-vel_n(1) / e.rm_h, vel_n(0) / e.rn_h, vel_n(0) / e.rn_h * e.tan_lat);
     e.omega_in_n = e.omega_ie_n + e.omega_en_n;
-    e.gravity_n = st.gravity_n;
+    e.gravity_n = Vec3(0.0, 0.0, -normal_gravity(sin_lat, height));
     return e;
-}
-
-Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n) {
-    return earth_with(site_of(0.0, sin_lat, cos_lat, height), vel_n);
 }
 
 Vec3 position_rate(const Earth& earth, const Vec3& vel_n) {

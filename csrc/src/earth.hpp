@@ -49,31 +49,8 @@ struct Earth {
     Vec3 gravity_n;    ///< normal gravity vector in n [m/s^2]
 };
 
-/// The Earth quantities of a position alone, without the velocity: what
-/// the strapdown keeps while the position moves less than a step
-/// (strapdown.hpp, "Site").
-struct Site {
-    double lat;        ///< the latitude they are for [rad]
-    double height;     ///< the height they are for [m]
-    double sin_lat;
-    double cos_lat;
-    double tan_lat;
-    double rm_h;       ///< R_M + h [m]
-    double rn_h;       ///< R_N + h [m]
-    Vec3 omega_ie_n;   ///< Earth rate in n [rad/s]
-    Vec3 gravity_n;    ///< normal gravity vector in n [m/s^2]
-};
-
-/// The Site at a latitude given by its sine and cosine. Qin (2014) eqs.
-/// 4.1.7, 4.1.9; TR8350.2 eq. 4-1. Precondition: |cos_lat| > 0.
-Site site_of(double lat, double sin_lat, double cos_lat, double height);
-
-/// Earth quantities at a site with a velocity: the transport rate added.
-/// Qin (2014) eqs. 4.1.10-4.1.11 (ENU).
-Earth earth_with(const Site& site, const Vec3& vel_n);
-
-/// All Earth quantities the strapdown update needs (earth_with of site_of).
-/// Precondition: |cos_lat| > 0.
+/// All Earth quantities the strapdown update needs. Qin (2014) eqs.
+/// 4.1.9-4.1.11 (ENU). Precondition: |cos_lat| > 0.
 Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n);
 
 /// [lat_dot, lon_dot, h_dot] [rad/s, rad/s, m/s]. Qin (2014) eq. 4.1.12.

@@ -1,8 +1,6 @@
 // strapdown.cpp: see strapdown.hpp. Mirrored by pyins/reference/strapdown.py.
 #include "strapdown.hpp"
 
-#include <cmath>
-
 #include "attitude.hpp"
 #include "earth.hpp"
 #include "math_portable.hpp"
@@ -60,13 +58,6 @@ History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, co
     return h;
 }
 
-earth::Site site_at(double lat, double height) {
-    double sin_lat;
-    double cos_lat;
-    pmath::sincos(lat, &sin_lat, &cos_lat);
-    return earth::site_of(lat, sin_lat, cos_lat, height);
-}
-
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     Strapdown s;
     s.nav = nav;
@@ -84,7 +75,6 @@ Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     if (vertical == Vertical::kHold) {
         s.nav.vel_n(2) = 0.0;
     }
-    s.site = site_at(s.nav.lat, s.nav.height);
     return s;
 }
 
@@ -96,14 +86,11 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     //    extrapolated to mid-tick (Yan 2019 sec. 4.1.4). The position is not
     //    extrapolated: half a tick moves a ship < 0.1 m, which changes
     //    gravity by < 1e-9 m/s^2.
-    //    The Site is kept while the position moves less than a step
-    //    (strapdown.hpp, "Site").
     const Vec3 vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n;
-    if (!(std::fabs(s.nav.lat - s.site.lat) <= kSiteLatStep) ||
-        !(std::fabs(s.nav.height - s.site.height) <= kSiteHeightStep)) {
-        s.site = site_at(s.nav.lat, s.nav.height);
-    }
-    const earth::Earth e = earth::earth_with(s.site, vel_mid);
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(s.nav.lat, &sin_lat, &cos_lat);
+    const earth::Earth e = earth::earth_at(sin_lat, cos_lat, s.nav.height, vel_mid);
 
     // 3. Velocity: specific force rotated into n with the rotation of n over
     //    the tick, then gravity and Coriolis (Yan 2019 eq. 4.1.27).

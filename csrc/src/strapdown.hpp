@@ -22,20 +22,8 @@
 // 2, eq. 26 expanded to second order): without it a swinging IMU sees a
 // rectified error of ~1 ug. The first two ticks after init, lacking history,
 // use the lower orders (no correction, then the two-sample 1/12 form).
-//
-// Site. The Earth quantities of the position alone (sin/cos/tan of the
-// latitude, the radii, the Earth rate, normal gravity: earth::Site) are kept
-// from tick to tick and computed again only when the latitude has moved by
-// more than kSiteLatStep or the height by more than kSiteHeightStep since;
-// the transport rate, which depends on the velocity, is computed every tick.
-// Within a step the kept values are off by at most: gravity 5e-9 m/s^2
-// (0.0005 ug) from the latitude, 3e-7 m/s^2 (0.03 ug) from the height; the
-// Earth rate 7e-12 rad/s (1.5e-6 deg/h); the radii 1e-9 relative: three
-// orders below the sensors' errors of a marine RLG INS (0.001 deg/h, 10
-// ug). A ship at rest computes them once; at 20 knots every ~6 ticks.
 #pragma once
 
-#include "earth.hpp"
 #include "types.hpp"
 
 namespace pyins::strapdown {
@@ -66,15 +54,9 @@ struct History {
 };
 
 /// Everything the update carries from one tick to the next.
-/// Largest latitude change before the Site is computed again [rad] (0.64 m).
-inline constexpr double kSiteLatStep = 1.0e-7;
-/// Largest height change before the Site is computed again [m].
-inline constexpr double kSiteHeightStep = 0.1;
-
 struct Strapdown {
     NavState nav;
     History hist;
-    earth::Site site;     ///< the Earth quantities of a position within a step of nav's
     Vec3 prev_dvel_n;     ///< v(k-1) - v(k-2), for the mid-tick velocity [m/s]
     Vertical vertical;
     double ref_height;    ///< height held in kHold mode [m]
@@ -114,9 +96,6 @@ void push_history(History& h, const Vec3& dtheta, const Vec3& dv, const Compensa
 /// A history from its increments alone, its past terms computed (the test
 /// hooks, which are handed increments).
 History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, const Vec3& dv2, int count);
-
-/// The Site at a position (sin and cos of the latitude by pmath::sincos).
-earth::Site site_at(double lat, double height);
 
 /// Start a strapdown at a navigation state.
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);

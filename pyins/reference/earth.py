@@ -73,45 +73,24 @@ class Earth:
     gravity_n: np.ndarray    #: normal gravity vector in n [m/s^2]
 
 
-@dataclass
-class Site:
-    """The Earth quantities of a position alone (mirrors ``pyins::earth::Site``)."""
-    lat: float           #: the latitude they are for [rad]
-    height: float        #: the height they are for [m]
-    sin_lat: float
-    cos_lat: float
-    tan_lat: float
-    rm_h: float          #: R_M + h [m]
-    rn_h: float          #: R_N + h [m]
-    omega_ie_n: np.ndarray   #: Earth rate in n [rad/s]
-    gravity_n: np.ndarray    #: normal gravity vector in n [m/s^2]
-
-
-def site_of(lat, sin_lat, cos_lat, height):
-    """Mirrors ``site_of``: radii, Earth rate, gravity of a position."""
-    rm, rn = principal_radii(sin_lat)
-    return Site(lat, height, sin_lat, cos_lat, sin_lat / cos_lat, rm + height, rn + height,
-                np.array([0.0, OMEGA_IE * cos_lat, OMEGA_IE * sin_lat]),
-                np.array([0.0, 0.0, -normal_gravity(sin_lat, height)]))
-
-
-def earth_with(site, vel_n):
-    """Mirrors ``earth_with``: a site's quantities and the transport rate,
-    omega_en^n = [-vN/(RM+h), vE/(RN+h), vE tanL/(RN+h)] (Qin 2014 eq. 4.1.10)."""
-    omega_en_n = np.array([-vel_n[1] / site.rm_h, vel_n[0] / site.rn_h, vel_n[0] / site.rn_h * site.tan_lat])
-    return Earth(site.sin_lat, site.cos_lat, site.tan_lat, site.rm_h, site.rn_h,
-                 site.omega_ie_n, omega_en_n, site.omega_ie_n + omega_en_n, site.gravity_n)
-
-
 def earth_at(sin_lat, cos_lat, height, vel_n):
     """All Earth quantities the strapdown update needs at one point.
 
-    Mirrors ``pyins::earth::earth_at`` (earth_with of site_of). The caller
-    passes sin and cos of the latitude (the C++ core computes them with its
-    own portable sin/cos). Qin (2014) eqs. 4.1.9-4.1.11 (ENU): omega_ie^n =
-    [0, W cosL, W sinL], omega_en^n = [-vN/(RM+h), vE/(RN+h), vE tanL/(RN+h)].
+    Mirrors ``pyins::earth::earth_at``. The caller passes sin and cos of the
+    latitude (the C++ core computes them with its own portable sin/cos).
+    Qin (2014) eqs. 4.1.9-4.1.11 (ENU): omega_ie^n = [0, W cosL, W sinL],
+    omega_en^n = [-vN/(RM+h), vE/(RN+h), vE tanL/(RN+h)].
     """
-    return earth_with(site_of(0.0, sin_lat, cos_lat, height), vel_n)
+    rm, rn = principal_radii(sin_lat)
+    rm_h = rm + height
+    rn_h = rn + height
+    tan_lat = sin_lat / cos_lat
+    omega_ie_n = np.array([0.0, OMEGA_IE * cos_lat, OMEGA_IE * sin_lat])
+    omega_en_n = np.array([-vel_n[1] / rm_h, vel_n[0] / rn_h, vel_n[0] / rn_h * tan_lat])
+    omega_in_n = omega_ie_n + omega_en_n
+    gravity_n = np.array([0.0, 0.0, -normal_gravity(sin_lat, height)])
+    return Earth(sin_lat, cos_lat, tan_lat, rm_h, rn_h,
+                 omega_ie_n, omega_en_n, omega_in_n, gravity_n)
 
 
 def position_rate(earth, vel_n):

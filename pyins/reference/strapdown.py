@@ -21,8 +21,6 @@ C3_NEAR = 121.0 / 720.0      #: kC3Near, (k-1) x (k)
 C3_FAR = -31.0 / 720.0       #: kC3Far, (k-2) x (k)
 C3_PAST = 1.0 / 720.0        #: kC3Past, (k-2) x (k-1)
 ONE_SIXTH = 1.0 / 6.0        #: kOneSixth
-SITE_LAT_STEP = 1.0e-7       #: kSiteLatStep [rad] (0.64 m)
-SITE_HEIGHT_STEP = 0.1       #: kSiteHeightStep [m]
 
 
 def _zeros():
@@ -69,7 +67,6 @@ class Strapdown:
     vertical: int = VERTICAL_HOLD
     ref_height: float = 0.0
     ref_lon: float = 0.0
-    site: earth.Site = None     #: the Earth quantities of a position within a step (None: none yet)
 
 
 class Compensated(NamedTuple):
@@ -116,11 +113,6 @@ def push_history(h, dtheta, dv, c):
         h.count = h.count + 1
 
 
-def site_at(lat, height):
-    """Mirrors ``site_at``."""
-    return earth.site_of(lat, np.sin(lat), np.cos(lat), height)
-
-
 def make_strapdown(nav, vertical):
     s = Strapdown(nav=NavState(nav.lat, nav.lon, nav.height,
                                np.array(nav.vel_n, dtype=float),
@@ -128,7 +120,6 @@ def make_strapdown(nav, vertical):
                   vertical=vertical, ref_height=nav.height, ref_lon=nav.lon)
     if vertical == VERTICAL_HOLD:
         s.nav.vel_n[2] = 0.0
-    s.site = site_at(s.nav.lat, s.nav.height)
     return s
 
 
@@ -141,13 +132,11 @@ def update(s, dtheta_p, dv_p, dt):
     c = compensate(dtheta_p, dv_p, s.hist)
     phi, dv_comp = c.phi, c.dv_p
 
-    # 2. Earth at the start position, velocity extrapolated to mid-tick; the
-    #    Site kept while the position moves less than a step (strapdown.hpp).
+    # 2. Earth at the start position, velocity extrapolated to mid-tick.
     vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n
-    if (s.site is None or not abs(s.nav.lat - s.site.lat) <= SITE_LAT_STEP
-            or not abs(s.nav.height - s.site.height) <= SITE_HEIGHT_STEP):
-        s.site = site_at(s.nav.lat, s.nav.height)
-    e = earth.earth_with(s.site, vel_mid)
+    sin_lat = np.sin(s.nav.lat)
+    cos_lat = np.cos(s.nav.lat)
+    e = earth.earth_at(sin_lat, cos_lat, s.nav.height, vel_mid)
 
     # 3. Velocity (Yan 2019 eq. 4.1.27).
     mat_np = attitude.quat_to_mat(s.nav.quat_np)
