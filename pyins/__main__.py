@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 from pyins import (__version__, bench, campaign, engine, logs, metrics, native, replay, replay_options, report,
-                   runner, runs, scenario, sim)
+                   runner, runs, scenario, sim, truth_track)
 from pyins.progress import Phases, TextProgress, phase
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, TICK_HZ
 
@@ -268,11 +268,16 @@ def cmd_replay(args):
     every = args.every if args.every is not None else hz
     if args.reference is not None and spec is not None:
         raise InputError("--reference: the log's scenario is its reference already (drop --reference)")
+    reference, truth_of = args.reference, spec
+    if args.truth is not None:        # the errors against the track, not the scenario's truth
+        if args.reference is not None:
+            raise InputError("--truth: one reference at a time (--reference or --truth)")
+        reference, truth_of = truth_track.read_track(args.truth), None
     bar = _progress(args)
     bar = bar(f"replaying {args.log}") if bar is not None and data.n else None
     try:
-        summary = replay.replay(blocks, cfg, out_dir, every=every, spec=spec, engine=args.engine,
-                                log_path=args.log, reference=args.reference,
+        summary = replay.replay(blocks, cfg, out_dir, every=every, spec=truth_of, engine=args.engine,
+                                log_path=args.log, reference=reference, t_first=data.metadata.get("t_first"),
                                 progress=None if bar is None else (lambda done: bar(min(done, data.n), data.n)))
     except KeyboardInterrupt:
         if os.path.exists(os.path.join(out_dir, "summary.json")):
@@ -304,7 +309,7 @@ def cmd_replay(args):
     if "errors" in summary:
         er = summary["errors"]
         extra = (f", final heading {er['heading_final_arcmin']:.3f}'" if "heading_final_arcmin" in er
-                 else f", max speed {er['speed_max_mps']:.3f} m/s")
+                 else f", max speed {er['speed_max_mps']:.3f} m/s" if "speed_max_mps" in er else "")
         _say(args, f"  against {er['reference']}: max horizontal {er['horizontal_max_m']:.2f} m{extra}")
     _say(args, f"  report: {page}")
     _emit_json(args, summary)
@@ -493,6 +498,10 @@ def build_parser():
     p.add_argument("--every", type=int, help="record every N samples (default: one a second)")
     p.add_argument("--reference", choices=replay.REFERENCES,
                    help="errors against: parked = the site (--lat/--lon/--height) and zero velocity")
+    p.add_argument("--truth", metavar="FILE",
+                   help="errors against a reference trajectory: a text file with a header line naming "
+                        "t, lat_deg, lon_deg [, height_m, heading_deg], t on the log's clock "
+                        "(docs/cli.md, \"pyins replay\")")
     p.add_argument("--out", help="output directory (default runs/replay)")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
                    help="the firmware: native (compiled, default) or reference (NumPy mirror)")

@@ -34,6 +34,7 @@ from pyins.reference import abi
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
+from pyins.truth_track import TruthTrack
 from pyins.runs import hold_interrupts
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
 
@@ -101,8 +102,10 @@ class _Summary:
     the records at once: each is a record, a max or a last value, and the
     errors are record by record (`metrics.nav_errors`, `sim.truth_at`)."""
 
-    def __init__(self, cfg, hz, spec, reference, errors):
+    def __init__(self, cfg, hz, spec, reference, errors, t_first=None):
         self.cfg, self.hz, self.spec, self.reference, self.errors = cfg, hz, spec, reference, errors
+        self.t_first = t_first
+        self.outside = 0          # records outside a truth track's time span
         self.records = 0
         self.last = self.first_nav = self.last_fine = None
         self.horizontal_max = self.level_max = self.speed_max = -np.inf
@@ -133,6 +136,21 @@ class _Summary:
             self.speed_max = max(self.speed_max, float(speed.max()))
             self.e_last = dict(horizontal=float(horizontal[-1]), north=float(err["north_m"][-1]),
                                east=float(err["east_m"][-1]))
+        elif isinstance(self.reference, TruthTrack):
+            # the records' times on the log's clock: the time stamp of their sample
+            ticks = recs["tick"].astype(float)
+            t = ticks / self.hz if self.t_first is None else self.t_first + (ticks - 1.0) / self.hz
+            inside, err = self.reference.errors(t, recs["lat_rad"], recs["lon_rad"], recs["heading_b_rad"])
+            self.outside += int(np.count_nonzero(~inside))
+            if not inside.any():
+                return
+            err["time_s"] = ticks[inside] / self.hz           # since the log's start, as the others
+            horizontal = np.hypot(err["north_m"], err["east_m"])
+            self.horizontal_max = max(self.horizontal_max, float(horizontal.max()))
+            self.e_last = dict(horizontal=float(horizontal[-1]), north=float(err["north_m"][-1]),
+                               east=float(err["east_m"][-1]))
+            if "heading_rad" in err:
+                self.e_last["heading"] = float(err["heading_rad"][-1])
         else:
             return
         for key, value in err.items():
@@ -162,12 +180,29 @@ class _Summary:
                                      horizontal_final_m=self.e_last["horizontal"],
                                      heading_final_arcmin=self.e_last["heading"] / ARCMIN_TO_RAD,
                                      level_max_arcsec=self.level_max / ARCSEC_TO_RAD)
-        elif self.reference == "parked":
+        elif isinstance(self.reference, str) and self.reference == "parked":
             summary["errors"] = dict(reference="the site, parked (zero velocity)",
                                      horizontal_max_m=self.horizontal_max,
                                      horizontal_final_m=self.e_last["horizontal"],
                                      north_final_m=self.e_last["north"], east_final_m=self.e_last["east"],
                                      speed_max_mps=self.speed_max)
+        elif isinstance(self.reference, TruthTrack):
+            track = self.reference
+            if self.e_last is None:
+                summary["warnings"].append(f"no record lies within the time span of {track.path} "
+                                           f"({track.t[0]:g} .. {track.t[-1]:g} s): no errors computed")
+            else:
+                summary["errors"] = dict(reference=f"the track in {os.path.basename(track.path)}",
+                                         horizontal_max_m=self.horizontal_max,
+                                         horizontal_final_m=self.e_last["horizontal"],
+                                         north_final_m=self.e_last["north"], east_final_m=self.e_last["east"],
+                                         compared=self.records - self.outside)
+                if "heading" in self.e_last:
+                    summary["errors"]["heading_final_arcmin"] = self.e_last["heading"] / ARCMIN_TO_RAD
+                if self.outside:
+                    summary["warnings"].append(
+                        f"{self.outside} of {self.records} records lie outside the time span of "
+                        f"{track.path} ({track.t[0]:g} .. {track.t[-1]:g} s) and were not compared")
         return summary
 
 
@@ -180,7 +215,7 @@ def _blocks(data, block):
 
 
 def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None,
-           block=BLOCK, progress=None):
+           block=BLOCK, progress=None, t_first=None):
     """Run a recorded IMU log through the firmware configured by ``cfg`` into
     ``out_dir`` and return the summary dict (also summary.json). ``data``: a
     pyins.sim.io.ImuData, or an iterable of them in order (the blocks of a
@@ -188,7 +223,10 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     phase across calls), its records and errors written as they come, so the
     memory does not grow with the log. ``spec``: the RunSpec the log was
     simulated from (its truth is the reference); ``reference="parked"``: the
-    site and zero velocity. ``progress(samples_done)`` after each block.
+    site and zero velocity; ``reference`` a `pyins.truth_track.TruthTrack`:
+    a trajectory on the log's clock, ``t_first`` the time stamp of the log's
+    first sample on it (None: the log has no time column; a sample's time is
+    then its tick x dt). ``progress(samples_done)`` after each block.
 
     Ctrl-C (KeyboardInterrupt) between blocks, or in one (a block is at most
     ``block`` samples: well under a second): the records so far are written
@@ -199,7 +237,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     # the guarded prefix
     engines.check(engine)
     every = max(1, int(every))
-    if reference is not None and reference not in REFERENCES:
+    if reference is not None and not isinstance(reference, TruthTrack) and reference not in REFERENCES:
         raise ValueError(f"reference: {reference!r} is not one of {', '.join(REFERENCES)}")
     hz = cfg.get("tick_hz") or TICK_HZ
 
@@ -209,7 +247,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     os.makedirs(out_dir, exist_ok=True)
     nav = logs.NpzWriter(os.path.join(out_dir, "navigation.npz"))
     err = logs.NpzWriter(os.path.join(out_dir, "errors.npz"))
-    acc = _Summary(cfg, hz, spec, reference, err)
+    acc = _Summary(cfg, hz, spec, reference, err, t_first=t_first)
     samples, interrupted = 0, False
     try:
         try:

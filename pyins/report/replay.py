@@ -101,7 +101,8 @@ def plot_alignment(rec, hz, path):
 
 
 def plot_errors(err, path):
-    """North, east and velocity errors against the reference."""
+    """North and east errors against the reference, and the velocity errors
+    (a scenario's truth, parked) or the heading error (a truth track)."""
     plt = pyplot()
     k = _decimate(len(err["time_s"]))
     t, tl = time_axis(np.asarray(err["time_s"])[k])
@@ -109,10 +110,18 @@ def plot_errors(err, path):
     ax[0].plot(t, np.asarray(err["north_m"])[k], label="north")
     ax[0].plot(t, np.asarray(err["east_m"])[k], label="east")
     ax[0].set_ylabel("position error [m]")
-    vel = np.asarray(err["vel_n_mps"])[k]
-    ax[1].plot(t, vel[:, 1], label="north")
-    ax[1].plot(t, vel[:, 0], label="east")
-    ax[1].set_ylabel("velocity error [m/s]")
+    if "vel_n_mps" in err:
+        vel = np.asarray(err["vel_n_mps"])[k]
+        ax[1].plot(t, vel[:, 1], label="north")
+        ax[1].plot(t, vel[:, 0], label="east")
+        ax[1].set_ylabel("velocity error [m/s]")
+    elif "heading_rad" in err:         # a truth track with headings
+        ax[1].plot(t, np.asarray(err["heading_rad"])[k] / ARCMIN_TO_RAD, label="heading")
+        ax[1].set_ylabel("heading error [arcmin]")
+    else:                              # a track of positions only
+        ax[1].plot(t, np.hypot(np.asarray(err["north_m"])[k], np.asarray(err["east_m"])[k]),
+                   label="horizontal")
+        ax[1].set_ylabel("horizontal error [m]")
     ax[1].set_xlabel(tl)
     for a in ax:
         a.grid(alpha=0.3)
