@@ -128,6 +128,14 @@ def _variant_dirs(run_dir):
     return out
 
 
+def _same_text(path, text):
+    try:
+        with open(path, encoding="utf-8") as f:
+            return f.read() == text
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
 def check_run_dir(scn, run_dir, force=False):
     """Refuse (RunDirError) to write ``scn`` into a directory that holds
     another scenario's run or files that are not a run's; with ``force`` a
@@ -137,6 +145,10 @@ def check_run_dir(scn, run_dir, force=False):
         return "new"
     entries = [e for e in os.listdir(run_dir) if e not in _FOREIGN_OK and ".tmp" not in e]
     if not entries:
+        return "new"
+    if entries == ["scenario.toml"] and _same_text(os.path.join(run_dir, "scenario.toml"), scn.text):
+        # a run of this scenario killed as it began (an older pyins wrote this file first):
+        # nothing of anyone's is lost by starting it again
         return "new"
     old = dir_digest(run_dir)
     if old is None:
@@ -327,8 +339,10 @@ def _start(scn, run_dir, resume, engine, force):
     if check_run_dir(scn, run_dir, force) == "new":
         resume = False
     src = scn.source if scn.source and os.path.exists(str(scn.source)) else None
-    records.write_atomic(os.path.join(run_dir, "scenario.toml"), scn.text)
+    # the resolved scenario first: it names the run (its digest), so a kill after it
+    # leaves a directory a resume recognises
     records.write_atomic(os.path.join(run_dir, "resolved_scenario.json"), scn.resolved_json())
+    records.write_atomic(os.path.join(run_dir, "scenario.toml"), scn.text)
     specs = list(scn.runs())
     written = written_durations(scn)
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,

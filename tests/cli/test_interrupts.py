@@ -17,6 +17,7 @@ import time
 import pytest
 
 from pyins import __main__ as cli
+from pyins import runs, scenario
 
 #: How long after SIGINT a command may take to exit. The brief is "a second
 #: or two"; 5 s leaves room for a machine shared with other jobs (the stop
@@ -242,3 +243,25 @@ def test_a_second_campaign_into_the_same_directory_is_refused(tmp_path):
     assert len(lines) == 1 and f"pid {proc.pid}" in lines[0] and "started" in lines[0], other.stderr
     rc, err, took = _stop(proc)
     assert rc == 130 and took < STOP_S, err
+
+
+def test_a_run_killed_as_it_began_is_started_again_and_a_users_file_is_kept(tmp_path):
+    """A kill between a run's first file and the file that names it (seen in
+    a campaign killed with SIGKILL: the resume refused the directory as "not
+    a pyins run directory"): the resolved scenario is now written first, and
+    a directory holding only this scenario's scenario.toml is started again;
+    one holding a different scenario.toml (a user's file) is still refused,
+    untouched."""
+    scn = scenario.load("seed000_static")
+    d = tmp_path / "run"
+    d.mkdir()
+    (d / "scenario.toml").write_text(scn.text)
+    assert runs.check_run_dir(scn, str(d)) == "new"
+    (d / "scenario.toml").write_text("# my own notes\n")
+    with pytest.raises(runs.RunDirError, match="not a pyins run directory"):
+        runs.check_run_dir(scn, str(d))
+    assert (d / "scenario.toml").read_text() == "# my own notes\n"
+    # the resolved scenario alone names the run: a resume recognises it
+    (d / "scenario.toml").unlink()
+    (d / "resolved_scenario.json").write_text(scn.resolved_json())
+    assert runs.check_run_dir(scn, str(d)) == "same"
