@@ -1787,7 +1787,21 @@ def _copy(src, dst):
         dst.write(chunk)
 
 
-class NpzWriter:
+class _Closing:
+    """A writer as a context manager: `close` when the block ends, `abort`
+    when it raises (nothing half-written keeps the final name)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+class NpzWriter(_Closing):
     """An .npz written block by block, in bounded memory: `append` sends an
     array's rows to a raw file beside ``path`` as they come, `put` keeps a
     small array whole; `close` assembles the archive (the members np.savez
@@ -1875,15 +1889,6 @@ class NpzWriter:
         self._discard()
         self.closed = True
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, exc_type, *exc):
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
-
 
 def _npz_header(f, path, name):
     version = np.lib.format.read_magic(f)
@@ -1938,7 +1943,7 @@ def _data_arrays(name, data):
     return tick.astype(np.int64), dtheta, dv, angle
 
 
-class LogWriter:
+class LogWriter(_Closing):
     """A log written block by block in one of the layouts `read_log` reads,
     in bounded memory: ``with LogWriter(path, fmt, **options) as w:
     w.write(block)`` for each ImuData block, in tick order. The options are
@@ -2152,15 +2157,6 @@ class LogWriter:
             self._file.close()
         _remove(self._plain)
         self.closed = True
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, exc_type, *exc):
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
 
 def write_log(path, data, fmt=None, *, dt=None, kind="increments", gyro_unit=None,
