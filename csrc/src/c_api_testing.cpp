@@ -155,6 +155,8 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
                                    : pyins::strapdown::Vertical::kHold;
     sd.ref_height = s->ref_height;
     sd.ref_lon = s->lon;
+    sd.lat0 = s->lat;  // a state handed in: anchored at its own latitude
+    pyins::pmath::sincos(sd.lat0, &sd.sin_lat0, &sd.cos_lat0);
     pyins::strapdown::update(sd, v3(dtheta_p), v3(dv_p), dt);
     s->lat = sd.nav.lat;
     s->lon = sd.nav.lon;

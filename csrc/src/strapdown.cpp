@@ -1,6 +1,8 @@
 // strapdown.cpp: see strapdown.hpp. Mirrored by pyins/reference/strapdown.py.
 #include "strapdown.hpp"
 
+#include <cmath>
+
 #include "attitude.hpp"
 #include "earth.hpp"
 #include "math_portable.hpp"
@@ -58,9 +60,25 @@ History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, co
     return h;
 }
 
+void lat_sincos(Strapdown& s, double* sin_lat, double* cos_lat) {
+    double d = s.nav.lat - s.lat0;
+    if (!(std::fabs(d) <= kLatAnchorStep)) {  // also a NaN
+        s.lat0 = s.nav.lat;
+        pmath::sincos(s.lat0, &s.sin_lat0, &s.cos_lat0);
+        d = 0.0;
+    }
+    const double d2 = d * d;
+    const double cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+    const double sd = d * (1.0 - d2 * (1.0 / 6.0));
+    *sin_lat = s.sin_lat0 * cd + s.cos_lat0 * sd;
+    *cos_lat = s.cos_lat0 * cd - s.sin_lat0 * sd;
+}
+
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     Strapdown s;
     s.nav = nav;
+    s.lat0 = nav.lat;
+    pmath::sincos(s.lat0, &s.sin_lat0, &s.cos_lat0);
     s.hist.dtheta1 = Vec3::Zero();
     s.hist.dv1 = Vec3::Zero();
     s.hist.dtheta2 = Vec3::Zero();
@@ -89,7 +107,7 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     const Vec3 vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n;
     double sin_lat;
     double cos_lat;
-    pmath::sincos(s.nav.lat, &sin_lat, &cos_lat);
+    lat_sincos(s, &sin_lat, &cos_lat);
     const earth::Earth e = earth::earth_at(sin_lat, cos_lat, s.nav.height, vel_mid);
 
     // 3. Velocity: specific force rotated into n with the rotation of n over

@@ -22,6 +22,14 @@
 // 2, eq. 26 expanded to second order): without it a swinging IMU sees a
 // rectified error of ~1 ug. The first two ticks after init, lacking history,
 // use the lower orders (no correction, then the two-sample 1/12 form).
+//
+// Latitude sine and cosine: the sine and cosine of an anchor latitude L0
+// are kept, and those of L = L0 + d are its angle sums with the series of
+// d: cos d = 1 - d^2/2 + d^4/24, sin d = d - d^3/6 (the next terms, d^6/720
+// and d^5/120, are below 1e-22 for |d| <= kLatAnchorStep: the result is the
+// sine to a few roundings, as pmath::sincos is); the anchor moves to L when
+// |d| would exceed the step (640 m). A dozen operations instead of a
+// reduction and two kernels.
 #pragma once
 
 #include "types.hpp"
@@ -54,9 +62,15 @@ struct History {
 };
 
 /// Everything the update carries from one tick to the next.
+/// Largest |lat - anchor| before the anchor moves [rad] (640 m).
+inline constexpr double kLatAnchorStep = 1.0e-4;
+
 struct Strapdown {
     NavState nav;
     History hist;
+    double lat0;          ///< the anchor latitude [rad]
+    double sin_lat0;      ///< its sine and cosine (pmath::sincos)
+    double cos_lat0;
     Vec3 prev_dvel_n;     ///< v(k-1) - v(k-2), for the mid-tick velocity [m/s]
     Vertical vertical;
     double ref_height;    ///< height held in kHold mode [m]
@@ -96,6 +110,9 @@ void push_history(History& h, const Vec3& dtheta, const Vec3& dv, const Compensa
 /// A history from its increments alone, its past terms computed (the test
 /// hooks, which are handed increments).
 History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, const Vec3& dv2, int count);
+
+/// Sine and cosine of s.nav.lat from the anchor (moved when too far).
+void lat_sincos(Strapdown& s, double* sin_lat, double* cos_lat);
 
 /// Start a strapdown at a navigation state.
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);

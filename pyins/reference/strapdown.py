@@ -21,6 +21,7 @@ C3_NEAR = 121.0 / 720.0      #: kC3Near, (k-1) x (k)
 C3_FAR = -31.0 / 720.0       #: kC3Far, (k-2) x (k)
 C3_PAST = 1.0 / 720.0        #: kC3Past, (k-2) x (k-1)
 ONE_SIXTH = 1.0 / 6.0        #: kOneSixth
+LAT_ANCHOR_STEP = 1.0e-4     #: kLatAnchorStep [rad] (640 m)
 
 
 def _zeros():
@@ -67,6 +68,9 @@ class Strapdown:
     vertical: int = VERTICAL_HOLD
     ref_height: float = 0.0
     ref_lon: float = 0.0
+    lat0: float = None          #: the anchor latitude (None: none yet) [rad]
+    sin_lat0: float = 0.0
+    cos_lat0: float = 1.0
 
 
 class Compensated(NamedTuple):
@@ -113,11 +117,26 @@ def push_history(h, dtheta, dv, c):
         h.count = h.count + 1
 
 
+def lat_sincos(s):
+    """Sine and cosine of s.nav.lat from the anchor, moved when more than
+    LAT_ANCHOR_STEP away (mirrors lat_sincos; strapdown.hpp says why)."""
+    d = s.nav.lat - s.lat0 if s.lat0 is not None else np.nan
+    if not abs(d) <= LAT_ANCHOR_STEP:
+        s.lat0 = s.nav.lat
+        s.sin_lat0, s.cos_lat0 = np.sin(s.lat0), np.cos(s.lat0)
+        d = 0.0
+    d2 = d * d
+    cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0))
+    sd = d * (1.0 - d2 * (1.0 / 6.0))
+    return s.sin_lat0 * cd + s.cos_lat0 * sd, s.cos_lat0 * cd - s.sin_lat0 * sd
+
+
 def make_strapdown(nav, vertical):
     s = Strapdown(nav=NavState(nav.lat, nav.lon, nav.height,
                                np.array(nav.vel_n, dtype=float),
                                np.array(nav.quat_np, dtype=float)),
-                  vertical=vertical, ref_height=nav.height, ref_lon=nav.lon)
+                  vertical=vertical, ref_height=nav.height, ref_lon=nav.lon,
+                  lat0=nav.lat, sin_lat0=np.sin(nav.lat), cos_lat0=np.cos(nav.lat))
     if vertical == VERTICAL_HOLD:
         s.nav.vel_n[2] = 0.0
     return s
@@ -134,8 +153,7 @@ def update(s, dtheta_p, dv_p, dt):
 
     # 2. Earth at the start position, velocity extrapolated to mid-tick.
     vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n
-    sin_lat = np.sin(s.nav.lat)
-    cos_lat = np.cos(s.nav.lat)
+    sin_lat, cos_lat = lat_sincos(s)
     e = earth.earth_at(sin_lat, cos_lat, s.nav.height, vel_mid)
 
     # 3. Velocity (Yan 2019 eq. 4.1.27).
