@@ -77,16 +77,22 @@ def _rotvec(q):
     return k * q[1:]
 
 
+def position_errors(lat_rad, lon_rad, lat_t, lon_t, height_t):
+    """North and east errors [m] of positions against true ones: the latitude
+    and longitude differences (the latter wrapped to (-pi, pi]) on the true
+    position's radii of curvature (WGS-84)."""
+    rm, rn = earth.principal_radii(np.sin(lat_t))
+    north = (lat_rad - lat_t) * (rm + height_t)
+    dlon = np.mod(lon_rad - lon_t + np.pi, TWO_PI) - np.pi
+    return north, dlon * (rn + height_t) * np.cos(lat_t)
+
+
 def nav_errors(result):
     """Position, velocity and attitude errors of a result with ``outputs``
     (firmware records), ``truth`` (pyins.sim.Truth at the same ticks) and
     ``dt`` (a runner.RunResult or a records.FilResult)."""
     out, tr = result.outputs, result.truth
-    lat_t = tr.lat
-    rm, rn = earth.principal_radii(np.sin(lat_t))
-    north = (out["lat_rad"] - lat_t) * (rm + tr.height)
-    dlon = np.mod(out["lon_rad"] - tr.lon + np.pi, TWO_PI) - np.pi
-    east = dlon * (rn + tr.height) * np.cos(lat_t)
+    north, east = position_errors(out["lat_rad"], out["lon_rad"], tr.lat, tr.lon, tr.height)
     # q_err = q_nb(computed) (x) conj(q_nb(true)) = rotation by -phi in n: the
     # mirror's formulas on every record at once ((4, N) arrays, element by element)
     q_err = attitude.quat_mul(np.asarray(out["quat_nb"]).T, attitude.quat_conj(np.asarray(tr.quat_nb).T))

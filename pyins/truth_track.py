@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyins import logs
-from pyins.reference import earth
+from pyins import logs, metrics
+from pyins.sim.imu import wrap_pi_mod
 from pyins.units import DEG_TO_RAD
 
 __all__ = ["TruthTrack", "read_track", "COLUMNS"]
@@ -60,13 +60,12 @@ class TruthTrack:
         lat_t = np.interp(ti, self.t, self.lat_rad)
         lon_t = np.interp(ti, self.t, self.lon_rad)
         h_t = np.interp(ti, self.t, self.height_m) if self.height_m is not None else np.zeros_like(ti)
-        rm, rn = earth.principal_radii(np.sin(lat_t))
-        dlon = np.mod(np.asarray(lon_rad)[inside] - lon_t + np.pi, 2.0 * np.pi) - np.pi
-        out = dict(time_s=ti, north_m=(np.asarray(lat_rad)[inside] - lat_t) * (rm + h_t),
-                   east_m=dlon * (rn + h_t) * np.cos(lat_t))
+        north, east = metrics.position_errors(np.asarray(lat_rad)[inside], np.asarray(lon_rad)[inside],
+                                              lat_t, lon_t, h_t)
+        out = dict(time_s=ti, north_m=north, east_m=east)
         if self.heading_rad is not None and heading_rad is not None:
             hd_t = np.interp(ti, self.t, self.heading_rad)
-            out["heading_rad"] = np.mod(np.asarray(heading_rad)[inside] - hd_t + np.pi, 2.0 * np.pi) - np.pi
+            out["heading_rad"] = wrap_pi_mod(np.asarray(heading_rad)[inside] - hd_t)
         return inside, out
 
 

@@ -54,10 +54,6 @@ void apply_errors(const double m[9], const double bias[3], double quantum, const
     }
 }
 
-}  // namespace
-
-namespace {
-
 /// The same double, bit for bit (-0.0 is not 0.0: its sine is -0.0).
 bool same_bits(double a, double b) {
     uint64_t ua = 0;
