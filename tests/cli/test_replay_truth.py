@@ -7,6 +7,7 @@ its peak, seed 002's sensor errors), so the scenario's own truth is an
 independent reference: the errors against the track written from that truth
 must be the errors against the scenario."""
 import json
+import os
 
 import numpy as np
 import pytest
@@ -115,3 +116,29 @@ def test_one_reference_at_a_time(demo, tmp_path, capsys):
                    "--reference", "parked", "--lat", "34.246", "--lon", "108.91", "--attitude", "1", "-2", "15"])
     assert rc == cli.EXIT_INPUT
     assert "one reference at a time" in capsys.readouterr().err
+
+
+def test_the_real_log_against_a_track_of_its_site_is_the_parked_reference(tmp_path):
+    """Real data: PSINS's laser-gyro log of a parked vehicle (tests/data),
+    120 s of coarse alignment, then navigation. A track holding the site at
+    two epochs spanning the log gives the north/east errors that
+    ``--reference parked`` gives (the same site, the same formula), to 1 mm;
+    its heading column (90.8 deg: the vehicle's heading written to 0.1 deg,
+    i.e. +-3') gives a final heading error within 30' (measured -1.3'): a
+    sign or clock error in the track's heading would give 180 deg or the
+    vehicle's whole heading."""
+    log = os.path.join(os.path.dirname(__file__), os.pardir, "data", "lasergyro_300s.imu.gz")
+    site = ["--lat", "34.246048", "--lon", "108.909664", "--height", "380", "--coarse", "120"]
+    track = tmp_path / "site.txt"
+    track.write_text("t lat_deg lon_deg height_m heading_deg\n"
+                     "0 34.246048 108.909664 380 90.8\n400 34.246048 108.909664 380 90.8\n")
+    out_p, out_t = tmp_path / "parked", tmp_path / "track"
+    assert cli.main(["replay", log, *site, "--reference", "parked", "--out", str(out_p), "--quiet"]) == 0
+    assert cli.main(["replay", log, *site, "--truth", str(track), "--out", str(out_t), "--quiet"]) == 0
+    ep, et = np.load(out_p / "errors.npz"), np.load(out_t / "errors.npz")
+    np.testing.assert_array_equal(ep["time_s"], et["time_s"])
+    np.testing.assert_allclose(et["north_m"], ep["north_m"], atol=1e-3)
+    np.testing.assert_allclose(et["east_m"], ep["east_m"], atol=1e-3)
+    s = json.loads((out_t / "summary.json").read_text())
+    assert abs(s["errors"]["heading_final_arcmin"]) < 30.0
+    assert s["errors"]["compared"] == len(et["time_s"]) == 300
