@@ -280,7 +280,12 @@ void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const dou
     pyins::indexing::init(ix, prm, meas0);
     for (size_t k = 0; k < n; ++k) {
         const double m = meas != nullptr ? meas[k] : ix.cmd_angle;
-        pyins::indexing::update(ix, m, yaw_b[k] + m);
+        double sn = 0.0;
+        double cs = 0.0;
+        if (pyins::indexing::wants_heading(ix)) {
+            pyins::pmath::sincos(yaw_b[k] + m, &sn, &cs);
+        }
+        pyins::indexing::update(ix, m, sn, cs);
         out[k].state = static_cast<int32_t>(ix.state);
         out[k].step = ix.step;
         out[k].fault = static_cast<int32_t>(ix.fault);

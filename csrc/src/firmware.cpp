@@ -143,13 +143,26 @@ void Firmware::start_navigation() {
     indexing::init(idx_, index_prm_, table_angle_);
 }
 
-double Firmware::imu_yaw() const {
+void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
     const Quat q_pb{enc_cos_half_, 0.0, 0.0, -enc_sin_half_};
     const Quat q_nb = attitude::quat_mul(sd_.nav.quat_np, q_pb);
-    // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler), from q directly
+    // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler): its cosine
+    // and sine are C11 / h and -C01 / h, h = |(C01, C11)| (no angle taken)
     const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
     const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
-    return wrap_pi(pmath::atan2(-c01, c11) + encoder_);
+    const double h = pmath::sqrt(c01 * c01 + c11 * c11);
+    double cb = 1.0;   // atan2(0, 0) = 0: the yaw of a vertical x axis
+    double sb = 0.0;
+    if (h > 0.0) {
+        cb = c11 / h;
+        sb = -c01 / h;
+    }
+    // psi_p = psi_b + alpha by the angle sum, alpha from the encoder's cached
+    // half-angle (cos a = c^2 - s^2, sin a = 2 s c)
+    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
+    *cos_yaw_p = cb * ca - sb * sa;
+    *sin_yaw_p = sb * ca + cb * sa;
 }
 
 void Firmware::update_rates(const Vec3& dtheta_p, double dalpha) {
@@ -721,7 +734,12 @@ void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     } else {
         strapdown::update(sd_, dtheta_p, dv_p, dt_);
         if (index_prm_.n_steps > 0) {
-            indexing::update(idx_, table_angle_, imu_yaw());
+            double sin_yaw_p = 0.0;
+            double cos_yaw_p = 0.0;
+            if (indexing::wants_heading(idx_)) {
+                imu_yaw_sincos(&sin_yaw_p, &cos_yaw_p);
+            }
+            indexing::update(idx_, table_angle_, sin_yaw_p, cos_yaw_p);
         }
     }
     // 6. The tick.

@@ -113,8 +113,9 @@ class Firmware {
     void hold_at_site();
     /// Enter NAVIGATE: the indexing cycle starts from the measured angle.
     void start_navigation();
-    /// IMU yaw psi_p = psi_b + alpha (docs/design.md §2) from the current solution.
-    double imu_yaw() const;
+    /// Sine and cosine of the IMU yaw psi_p = psi_b + alpha (docs/design.md
+    /// §2) from the current solution, without taking the angle.
+    void imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const;
     /// Lever arm (docs/concepts.md, "Lever arms"): rate estimates at the end
     /// of this tick from its increments and the last tick's.
     void update_rates(const Vec3& dtheta_p, double dalpha);

@@ -160,7 +160,14 @@ void reset(Indexer& ix, double meas) {
     ix.fallbacks = fallbacks;
 }
 
-void update(Indexer& ix, double meas, double yaw_p) {
+bool wants_heading(const Indexer& ix) {
+    if (ix.state == State::kStop) {
+        return true;
+    }
+    return ix.state == State::kMove && (ix.prm.sums == kSumsAll || !ix.target_known);
+}
+
+void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
     const double jumped = std::fabs(meas - ix.prev_meas);
     ix.prev_meas = meas;
     if (ix.state == State::kIdle || ix.state == State::kFault) {
@@ -171,11 +178,9 @@ void update(Indexer& ix, double meas, double yaw_p) {
         return;
     }
     if (ix.state == State::kStop) {
-        double s;
-        double c;
-        pmath::sincos(yaw_p, &s, &c);
-        ix.a_c = ix.a_c + c;
-        ix.a_s = ix.a_s + s;
+        // A_c, A_s accumulate cos and sin of psi_p while stopped (seed 002 sec. 2)
+        ix.a_c = ix.a_c + cos_yaw_p;
+        ix.a_s = ix.a_s + sin_yaw_p;
         ix.stop_count = ix.stop_count + 1;
         if (off_command(ix, meas, Fault::kDrift)) {
             return;
@@ -185,22 +190,16 @@ void update(Indexer& ix, double meas, double yaw_p) {
         }
         return;
     }
-    // kMove: the heading's sin and cos only where they are used, once
+    // kMove
     const Step& s = ix.prm.steps[ix.step];
-    const bool sum_turn = ix.prm.sums == kSumsAll;
-    double sn = 0.0;
-    double cs = 0.0;
-    if (sum_turn || !ix.target_known) {
-        pmath::sincos(yaw_p, &sn, &cs);
-    }
-    if (sum_turn) {
+    if (ix.prm.sums == kSumsAll) {
         // our extension: the turn's ticks count too (before the test, as a
         // stopped tick's heading counts before its stop may end)
-        ix.a_c = ix.a_c + cs;
-        ix.a_s = ix.a_s + sn;
+        ix.a_c = ix.a_c + cos_yaw_p;
+        ix.a_s = ix.a_s + sin_yaw_p;
     }
     if (!ix.target_known) {
-        if (flex_condition(ix, s.kind, sn, cs)) {
+        if (flex_condition(ix, s.kind, sin_yaw_p, cos_yaw_p)) {
             // stop as soon as the profile allows: brake from here
             const double v = std::fabs(ix.cmd_rate);
             ix.target = ix.cmd_angle + sense(s.angle) * (v * v / (2.0 * ix.prm.accel));

@@ -92,9 +92,15 @@ int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps);
 /// Start at the measured (unwrapped) table angle, first step, stopped.
 void init(Indexer& ix, const Params& prm, double meas);
 
+/// Whether this tick's update reads the IMU heading: a stop sums it, a move
+/// tests it while its flexible target is open or when the turn's ticks are
+/// summed too. The caller computes sin/cos psi_p only then.
+bool wants_heading(const Indexer& ix);
+
 /// One tick, after the navigation update: meas = unwrapped encoder angle at
-/// t_k [rad], yaw_p = IMU yaw from the solution [rad].
-void update(Indexer& ix, double meas, double yaw_p);
+/// t_k [rad]; sin_yaw_p, cos_yaw_p = sine and cosine of the IMU yaw psi_p
+/// from the solution (read only where wants_heading says; 0 otherwise).
+void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p);
 
 /// Leave FAULT: start the cycle again at the measured angle, keeping A_c, A_s.
 void reset(Indexer& ix, double meas);

@@ -138,13 +138,21 @@ class Firmware:
         self.mode = abi.PYINS_MODE_NAVIGATE
         self.idx = indexing.init(self.index_prm, self.table_angle)
 
-    def imu_yaw(self):
-        """psi_p = psi_b + alpha (mirrors Firmware::imu_yaw)."""
+    def imu_yaw_sincos(self):
+        """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors
+        Firmware::imu_yaw_sincos)."""
         q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
         w, x, y, z = attitude.quat_mul(self.sd.nav.quat_np, q_pb)
         c01 = 2.0 * (x * y - w * z)
         c11 = w * w - x * x + y * y - z * z
-        return wrap_pi(np.arctan2(-c01, c11) + self.encoder)
+        h = np.sqrt(c01 * c01 + c11 * c11)
+        cb, sb = 1.0, 0.0  # atan2(0, 0) = 0
+        if h > 0.0:
+            cb = c11 / h
+            sb = -c01 / h
+        ca = self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half
+        sa = 2.0 * self.enc_sin_half * self.enc_cos_half
+        return sb * ca + cb * sa, cb * ca - sb * sa
 
     def update_rates(self, dtheta_p, dalpha):
         """Rates at the end of the tick, second order (mirrors update_rates)."""
@@ -525,7 +533,10 @@ class Firmware:
         else:
             strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
             if self.index_prm.n_steps > 0:
-                indexing.update(self.idx, self.table_angle, self.imu_yaw())
+                sn = cs = 0.0
+                if indexing.wants_heading(self.idx):
+                    sn, cs = self.imu_yaw_sincos()
+                indexing.update(self.idx, self.table_angle, sn, cs)
         # 6. The tick.
         self.tick = self.tick + 1
 

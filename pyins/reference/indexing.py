@@ -177,8 +177,17 @@ def reset(ix, meas):
     return new
 
 
-def update(ix, meas, yaw_p):
-    """One tick (mirrors ``indexing::update``)."""
+def wants_heading(ix):
+    """Whether this tick's update reads the IMU heading (mirrors
+    ``indexing::wants_heading``)."""
+    if ix.state == STATE_STOP:
+        return True
+    return ix.state == STATE_MOVE and (ix.prm.sums == SUMS_ALL or not ix.target_known)
+
+
+def update(ix, meas, sin_yaw_p, cos_yaw_p):
+    """One tick (mirrors ``indexing::update``); the heading as its sine and
+    cosine, read only where ``wants_heading`` says."""
     jumped = abs(meas - ix.prev_meas)
     ix.prev_meas = meas
     if ix.state in (STATE_IDLE, STATE_FAULT):
@@ -187,26 +196,23 @@ def update(ix, meas, yaw_p):
         _enter_fault(ix, FAULT_JUMP)
         return
     if ix.state == STATE_STOP:
-        ix.a_c = ix.a_c + np.cos(yaw_p)
-        ix.a_s = ix.a_s + np.sin(yaw_p)
+        # A_c, A_s accumulate cos and sin of psi_p while stopped (seed 002 sec. 2)
+        ix.a_c = ix.a_c + cos_yaw_p
+        ix.a_s = ix.a_s + sin_yaw_p
         ix.stop_count = ix.stop_count + 1
         if _off_command(ix, meas, FAULT_DRIFT):
             return
         if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
             _start_move(ix)
         return
-    # kMove: the heading's sin and cos only where they are used, once
+    # kMove
     s = ix.prm.steps[ix.step]
-    sum_turn = ix.prm.sums == SUMS_ALL
-    sn = cs = 0.0
-    if sum_turn or not ix.target_known:
-        sn, cs = np.sin(yaw_p), np.cos(yaw_p)
-    if sum_turn:
+    if ix.prm.sums == SUMS_ALL:
         # our extension: the turn's ticks count too (before the test)
-        ix.a_c = ix.a_c + cs
-        ix.a_s = ix.a_s + sn
+        ix.a_c = ix.a_c + cos_yaw_p
+        ix.a_s = ix.a_s + sin_yaw_p
     if not ix.target_known:
-        if _flex_condition(ix, s.kind, sn, cs):
+        if _flex_condition(ix, s.kind, sin_yaw_p, cos_yaw_p):
             v = abs(ix.cmd_rate)
             ix.target = ix.cmd_angle + _sense(s.angle) * (v * v / (2.0 * ix.prm.accel))
             ix.target_known = True
@@ -228,7 +234,10 @@ def run(prm, meas0, meas, yaw_b):
     out = []
     for k in range(len(yaw_b)):
         m = meas[k] if meas is not None else ix.cmd_angle
-        update(ix, m, yaw_b[k] + m)
+        sn = cs = 0.0
+        if wants_heading(ix):
+            sn, cs = np.sin(yaw_b[k] + m), np.cos(yaw_b[k] + m)
+        update(ix, m, sn, cs)
         out.append((ix.state, ix.step, ix.fault, ix.fallbacks, ix.cmd_angle, ix.cmd_rate,
                     ix.a_c, ix.a_s))
     return out
