@@ -24,6 +24,7 @@ starts), then named steps:
 """
 import math
 import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -35,6 +36,9 @@ from pyins.sim.turntable import TableConfig, error_matrices
 from pyins.units import DT
 
 __all__ = ["run_fil"]
+
+#: Ticks of normals drawn at a time into the noise's scratch buffer (2.4 MB).
+NOISE_BLOCK = 50_000
 
 
 class _Loop:
@@ -53,6 +57,7 @@ class _Loop:
             self.omega, self.force, self.x, self.w = sim.node_rates(motion, np.arange(self.period), dt=dt,
                                                                     nodes=nodes)
         self.done = 0
+        self.bufs, self.slot, self.z = None, 1, None     # the noise's buffers (noise)
 
     def ship_rates(self, n):
         """(omega, force, x, w, period, phase0) of the next ``n`` ticks."""
@@ -64,12 +69,25 @@ class _Loop:
 
     def noise(self, n):
         """The white-noise increments of the next ``n`` ticks (gyro, accel), drawn
-        as pyins.sim.SensorModel draws them, or (None, None) without noise."""
+        as pyins.sim.SensorModel draws them (None, None without noise),
+        and the generator's state after the draw (what a checkpoint after
+        these ticks keeps). The normals go into one of two buffers kept for
+        the run (a fresh array per chunk would cost as much in page faults as
+        the draw), so a result is valid until the next call but one."""
         if not self.noisy:
-            return None, None
-        z = self.rng.standard_normal((n, 6))
-        return (np.ascontiguousarray((self.errors.gyro_arw * self.sq) * z[:, :3]),
-                np.ascontiguousarray((self.errors.accel_vrw * self.sq) * z[:, 3:]))
+            return None, None, None
+        self.slot = 1 - self.slot
+        if self.bufs is None or self.bufs[0][0].shape[0] < n:
+            self.bufs = [(np.empty((n, 3)), np.empty((n, 3))) for _ in range(2)]
+            self.z = np.empty((NOISE_BLOCK, 6))
+        g, a = (b[:n] for b in self.bufs[self.slot])
+        for i in range(0, n, NOISE_BLOCK):       # block by block: the same stream of draws
+            m = min(NOISE_BLOCK, n - i)
+            z = self.z[:m]
+            self.rng.standard_normal(out=z)
+            np.multiply(self.errors.gyro_arw * self.sq, z[:, :3], out=g[i:i + m])
+            np.multiply(self.errors.accel_vrw * self.sq, z[:, 3:], out=a[i:i + m])
+        return g, a, self.rng.bit_generator.state
 
 
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
@@ -118,7 +136,9 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
 
     # 2. the record directory, fresh or from its last checkpoint
     sink = None
-    outs, recs = [], []
+    # without a record directory the records collect in arrays of the run's
+    # size (one copy of each chunk's, none at the end)
+    outs, recs, kept = None, None, 0
     if record_dir is not None:
         os.makedirs(record_dir, exist_ok=True)
         digest = records.run_digest(motion, duration_ticks, cfg, errors, seed, table, every,
@@ -137,37 +157,53 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             os.remove(ck_path)
         last_ck = loop.done
 
-    # 3. chunk by chunk: the ship's rates, the noise, the closed loop, the records
-    while loop.done < duration_ticks:
-        n = min(chunk_ticks, duration_ticks - loop.done)
-        omega, force, x, w, period, phase0 = loop.ship_rates(n)
-        g_noise, a_noise = loop.noise(n)
-        try:
-            out, rec = loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise,
-                                      n, dt, every)
-        except native.PlantError as exc:         # keep what was done before the rejected sample
+    # 3. chunk by chunk: the ship's rates, the noise, the closed loop, the
+    #    records. The next chunk's noise is drawn on a helper thread while
+    #    this chunk's loop runs (both release the GIL): the same draws in the
+    #    same order as one after the other.
+    ahead = ThreadPoolExecutor(max_workers=1)
+    try:
+        pending = (ahead.submit(loop.noise, min(chunk_ticks, duration_ticks - loop.done))
+                   if loop.done < duration_ticks else None)
+        while loop.done < duration_ticks:
+            n = min(chunk_ticks, duration_ticks - loop.done)
+            omega, force, x, w, period, phase0 = loop.ship_rates(n)
+            g_noise, a_noise, rng_state = pending.result()
+            n_next = min(chunk_ticks, duration_ticks - loop.done - n)
+            pending = ahead.submit(loop.noise, n_next) if n_next > 0 else None
+            try:
+                out, rec = loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise,
+                                          n, dt, every)
+            except native.PlantError as exc:         # keep what was done before the rejected sample
+                if sink is not None:
+                    sink.write(exc.outputs, exc.records)
+                    sink.close()
+                raise
             if sink is not None:
-                sink.write(exc.outputs, exc.records)
-                sink.close()
-            raise
-        if sink is not None:
-            sink.write(out, rec)
-        else:
-            outs.append(out.copy())
-            recs.append(rec.copy())
-        loop.done += n
+                sink.write(out, rec)
+            else:
+                if outs is None:
+                    cap = (duration_ticks - loop.done) // every + 1
+                    outs, recs = np.empty(cap, dtype=out.dtype), np.empty(cap, dtype=rec.dtype)
+                outs[kept:kept + len(out)] = out
+                recs[kept:kept + len(rec)] = rec
+                kept += len(out)
+            loop.done += n
 
-        # 4. a checkpoint when one is due (and at the end)
-        if sink is not None and (loop.done >= duration_ticks or
-                                 (checkpoint_ticks is not None and loop.done - last_ck >= checkpoint_ticks)):
-            sink.sync()
-            if checkpoint_ticks is not None or resume:
-                records.write_checkpoint(ck_path, digest, loop.done, sink.n_records, loop.fw.snapshot(),
-                                         loop.plant.snapshot(), loop.rng.bit_generator.state)
-            records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
-            last_ck = loop.done
-        if progress is not None:
-            progress(loop.done, duration_ticks)
+            # 4. a checkpoint when one is due (and at the end)
+            if sink is not None and (loop.done >= duration_ticks or
+                                     (checkpoint_ticks is not None and loop.done - last_ck >= checkpoint_ticks)):
+                sink.sync()
+                if checkpoint_ticks is not None or resume:
+                    records.write_checkpoint(ck_path, digest, loop.done, sink.n_records, loop.fw.snapshot(),
+                                             loop.plant.snapshot(),
+                                             rng_state if rng_state is not None else loop.rng.bit_generator.state)
+                records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
+                last_ck = loop.done
+            if progress is not None:
+                progress(loop.done, duration_ticks)
+    finally:
+        ahead.shutdown(wait=True, cancel_futures=True)
 
     # 5. the result: the records beside the truth
     if sink is not None:
@@ -176,7 +212,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
         outputs, plant, _ = load_records(record_dir)
     else:
-        outputs = np.concatenate(outs)
-        plant = np.concatenate(recs)
+        outputs = outs[:kept] if outs is not None else np.empty(0, dtype=native.OUTPUT_DTYPE)
+        plant = recs[:kept] if recs is not None else np.empty(0, dtype=PLANT_RECORD_DTYPE)
     truth = sim.truth_at(motion, np.asarray(outputs["tick"]), dt=dt)
     return FilResult(outputs=outputs, plant=plant, truth=truth, dt=dt)
