@@ -42,6 +42,12 @@ Quat quat_normalize(const Quat& q) {
     return Quat{q.w * inv, q.x * inv, q.y * inv, q.z * inv};
 }
 
+Vec3 quat_rotate(const Quat& q, const Vec3& v) {
+    const Vec3 r(q.x, q.y, q.z);
+    const Vec3 t = 2.0 * cross(r, v);
+    return v + q.w * t + cross(r, t);
+}
+
 Mat3 quat_to_mat(const Quat& q) {
     const double ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
     const double xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;

@@ -22,6 +22,11 @@ bool saturated3(const double v[3], double limit) {
     return std::fabs(v[0]) >= limit || std::fabs(v[1]) >= limit || std::fabs(v[2]) >= limit;
 }
 
+/// Every component finite and inside the limit (a NaN compares false).
+bool within(const double v[3], double limit) {
+    return std::fabs(v[0]) < limit && std::fabs(v[1]) < limit && std::fabs(v[2]) < limit;
+}
+
 /// counter + n, saturating at 2^32 - 1 (a counter never wraps to look healthy).
 void count(uint32_t* counter, uint32_t n) {
     *counter = n > 0xFFFFFFFFu - *counter ? 0xFFFFFFFFu : *counter + n;
@@ -501,9 +506,7 @@ int64_t Firmware::ticks_for(const pyins_sample& sample) const {
     return seq.kind == SeqKind::kRepeat ? 0 : static_cast<int64_t>(seq.missing) + 1;
 }
 
-int Firmware::step(const pyins_sample& sample, pyins_output* out) {
-    // docs/core.md, "Sample-level faults": the checks in this order.
-    // 1. Reject a non-finite sample, then a saturated one.
+int Firmware::reject_sample(const pyins_sample& sample, pyins_output* out) {
     if (!finite3(sample.dtheta_p_rad) || !finite3(sample.dv_p_mps) ||
         !std::isfinite(sample.table_angle_rad)) {
         reject(static_cast<uint32_t>(PYINS_FAULT_SAMPLE_NONFINITE), &counts_.nonfinite);
@@ -512,15 +515,25 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
         }
         return PYINS_E_SAMPLE_NONFINITE;
     }
-    // Beyond the IMU's range the true increment is unknown (a shock) or the
-    // word is corrupted: rejected like a non-finite one.
-    if (saturated3(sample.dtheta_p_rad, cfg_.sat_gyro_rad) ||
-        saturated3(sample.dv_p_mps, cfg_.sat_accel_mps)) {
-        reject(static_cast<uint32_t>(PYINS_FAULT_SAMPLE_SATURATED), &counts_.saturated);
-        if (out != nullptr) {
-            output(out);
-        }
-        return PYINS_E_SAMPLE_SATURATED;
+    // Finite, so beyond the IMU's range (the limits are finite and > 0):
+    // the true increment is unknown (a shock) or the word is corrupted,
+    // rejected like a non-finite one.
+    reject(static_cast<uint32_t>(PYINS_FAULT_SAMPLE_SATURATED), &counts_.saturated);
+    if (out != nullptr) {
+        output(out);
+    }
+    return PYINS_E_SAMPLE_SATURATED;
+}
+
+int Firmware::step(const pyins_sample& sample, pyins_output* out) {
+    // docs/core.md, "Sample-level faults": the checks in this order.
+    // 1. Reject a non-finite sample, then a saturated one. A good sample
+    //    passes both in one test (|v| < limit is false for a NaN and an
+    //    infinity too); only a sample that fails it is told apart.
+    const bool good = within(sample.dtheta_p_rad, cfg_.sat_gyro_rad) &&
+                      within(sample.dv_p_mps, cfg_.sat_accel_mps) && std::isfinite(sample.table_angle_rad);
+    if (!good) {
+        return reject_sample(sample, out);
     }
     // 2. The sequence: drop a duplicate; note a gap or a resynchronisation.
     int status = PYINS_OK;

@@ -97,6 +97,10 @@ class Firmware {
     /// this one, the encoder along the shortest turn between their readings.
     void bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
     /// A rejected sample: sticky bit, counter, and an alignment restart.
+    /// Step 1's slow path, for a sample that failed the one-pass test: a
+    /// non-finite one, else a saturated one (the limits are finite and > 0,
+    /// config::config_check), rejected with its fault bit and counter.
+    int reject_sample(const pyins_sample& sample, pyins_output* out);
     void reject(uint32_t fault_bit, uint32_t* counter);
     /// Leave coarse alignment for fine alignment or navigation.
     void end_coarse();

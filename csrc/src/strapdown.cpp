@@ -96,7 +96,7 @@ Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     return s;
 }
 
-Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
+PYINS_HOT_FLATTEN Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
     // 1. Coning, sculling and rotation compensation (strapdown.hpp).
     const Compensated c = compensate(dtheta_p, dv_p, s.hist);
 
@@ -112,8 +112,7 @@ Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv_p, double dt) {
 
     // 3. Velocity: specific force rotated into n with the rotation of n over
     //    the tick, then gravity and Coriolis (Yan 2019 eq. 4.1.27).
-    const Mat3 mat_np = attitude::quat_to_mat(s.nav.quat_np);
-    const Vec3 dv_n0 = mat_np * c.dv_p;
+    const Vec3 dv_n0 = attitude::quat_rotate(s.nav.quat_np, c.dv_p);
     const Vec3 dv_sf_n = dv_n0 - 0.5 * dt * cross(e.omega_in_n, dv_n0);
     const Vec3 coriolis_n = cross(2.0 * e.omega_ie_n + e.omega_en_n, vel_mid);
     const Vec3 dv_cor_n = (e.gravity_n - coriolis_n) * dt;

@@ -70,6 +70,14 @@ def quat_normalize(q):
     return np.array([q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv])
 
 
+def quat_rotate(q, v):
+    """q v q* for a unit q, written out: t = 2 r x v, v' = v + w t + r x t
+    (mirrors pyins::attitude::quat_rotate)."""
+    r = np.array([q[1], q[2], q[3]])
+    t = 2.0 * cross(r, v)
+    return v + q[0] * t + cross(r, t)
+
+
 def quat_to_mat(q):
     """C from a unit quaternion (Qin 2014 eq. 9.2.34)."""
     w, x, y, z = q

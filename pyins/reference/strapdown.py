@@ -157,8 +157,7 @@ def update(s, dtheta_p, dv_p, dt):
     e = earth.earth_at(sin_lat, cos_lat, s.nav.height, vel_mid)
 
     # 3. Velocity (Yan 2019 eq. 4.1.27).
-    mat_np = attitude.quat_to_mat(s.nav.quat_np)
-    dv_n0 = mat_np @ dv_comp
+    dv_n0 = attitude.quat_rotate(s.nav.quat_np, dv_comp)
     dv_sf_n = dv_n0 - 0.5 * dt * cross(e.omega_in_n, dv_n0)
     coriolis_n = cross(2.0 * e.omega_ie_n + e.omega_en_n, vel_mid)
     dv_cor_n = (e.gravity_n - coriolis_n) * dt
