@@ -2,6 +2,8 @@
 """Benchmark: firmware-in-the-loop speed.
 
     .venv/bin/python tools/bench_fil.py [--hours 72] [--json runs/bench/fil.json]
+    .venv/bin/python tools/bench_fil.py --count [--hours 0.5] [--dump DIR]
+    .venv/bin/python tools/bench_fil.py --dump DIR [--hours 0.5]
 
 1. A 10-minute closed-loop run (seed 002 experiment 1, flexible scheme,
    seed 002 sensor errors) three ways: compiled plant + C++ firmware
@@ -10,13 +12,28 @@
    ratios. The compiled plant's own cost is the difference of the first two.
 2. The full --hours run (default 72 h = 25.9 M ticks) through run_fil:
    wall time and peak memory (target < 60 s and < 1 GiB).
+3. (``--count``, also at the end of the default run) the machine-independent
+   cost: valgrind callgrind's instructions per tick inside pyins_fil_run
+   (plant + firmware), of which inside pyins_run (the firmware; the plant is
+   the difference), over --hours of the same closed loop (default 0.5 h =
+   180,000 ticks; the default run counts 0.5 h), through the C driver
+   build/host/fil_count on the inputs run_fil builds (dumped to DIR, default
+   build/host/fil_dump). fil_count's last lat_rad must equal the Python
+   run_fil's bit for bit. ``--count`` alone runs only this and adds its
+   figures to the existing JSON. ``--dump DIR`` alone only writes the inputs.
 """
 import argparse
+import inspect
 import json
 import os
+import re
 import resource
+import shutil
+import struct
+import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -25,16 +42,214 @@ from pyins.reference import firmware as ref_firmware
 from pyins.sim import turntable
 from pyins.units import DT, TICK_HZ
 
+ROOT = Path(__file__).resolve().parent.parent
+BUILD = ROOT / "build" / "host"
+FIL_COUNT = BUILD / "fil_count"
+
+
+def the_case():
+    """The closed loop every part of this benchmark runs: (motion, errors, config, seed, every)."""
+    return sim.HeadingSwing.experiment(1), sim.preset("seed002"), dict(index_scheme=4), 1, 100
+
+
+# ---------------------------------------------------------------------------
+# 3. instruction counts: the inputs of one pyins_fil_run call, the C driver
+#    on them under callgrind
+
+def dump_inputs(out_dir, n):
+    """Write the inputs of pyins_fil_run over the first ``n`` ticks of the
+    case, built as run_fil builds them (one chunk of ``n`` ticks), to
+    ``out_dir`` (the files tools/fil_count.c reads), plus ``fil_dump.json``
+    with the sizes and the Python run_fil's final lat_rad. Returns that dict."""
+    m, errors, config, seed, every = the_case()
+    defaults = {k: v.default for k, v in inspect.signature(fil.run_fil).parameters.items()}
+    dt, nodes = defaults["dt"], defaults["nodes"]
+    # run_fil's step 1 (the loop's parts), as there
+    table = turntable.TableConfig()
+    cfg = fil.initial_config(m, None, **config)
+    loop = fil._Loop(m, cfg, errors, seed, table, dt, nodes, "native")
+    if not isinstance(loop.plant, native.Plant):
+        raise RuntimeError(f"run_fil's native plant is a {type(loop.plant).__name__}, not native.Plant")
+    # its step 3 for one chunk of n ticks: the ship's rates, then the noise
+    omega, force, x, w, period, phase0 = loop.ship_rates(n)
+    drawn = loop.noise(n)
+    g_noise, a_noise = drawn[0], drawn[1]
+    # the pyins_config the firmware was initialised from (native.Firmware: make_config(cfg))
+    c_cfg = native.make_config(cfg)
+    ffi = native.ffi
+    os.makedirs(out_dir, exist_ok=True)
+    for name in ("gyro_noise.bin", "accel_noise.bin"):      # a stale noise file would be read
+        if os.path.exists(os.path.join(out_dir, name)):
+            os.remove(os.path.join(out_dir, name))
+
+    def put(name, data):
+        with open(os.path.join(out_dir, name), "wb") as f:
+            f.write(data)
+
+    put("config.bin", bytes(ffi.buffer(c_cfg, ffi.sizeof("pyins_config"))))
+    put("plant_state.bin", bytes(ffi.buffer(loop.plant._st, ffi.sizeof("pyins_plant_state"))))
+    put("table_config.bin", bytes(ffi.buffer(loop.plant._tab, ffi.sizeof("pyins_table_config"))))
+    put("imu_errors.bin", bytes(ffi.buffer(loop.plant._err, ffi.sizeof("pyins_imu_errors"))))
+    put("params.bin", struct.pack("=5qd", int(period), len(x), int(every), int(n), int(phase0), float(dt)))
+    arrays = {"omega.bin": omega, "force.bin": force, "x.bin": x, "w.bin": w}
+    if g_noise is not None:
+        arrays.update({"gyro_noise.bin": g_noise, "accel_noise.bin": a_noise})
+    for name, arr in arrays.items():
+        put(name, np.ascontiguousarray(arr, dtype=np.float64).tobytes())
+
+    # the Python run of the same n in one chunk: what fil_count must reproduce
+    res = fil.run_fil(m, n, config=config, errors=errors, seed=seed, every=every, chunk_ticks=max(n, 1))
+    lat = float(res.outputs["lat_rad"][-1])
+    info = {
+        "ticks": int(n), "period": int(period), "nodes": len(x), "phase0": int(phase0), "dt": float(dt),
+        "every": int(every), "noise": g_noise is not None,
+        "sizeof": {t: ffi.sizeof(t) for t in ("pyins_config", "pyins_plant_state", "pyins_table_config",
+                                                "pyins_imu_errors", "pyins_output")},
+        "doubles": {k: int(np.asarray(v).size) for k, v in arrays.items()},
+        "python_final_lat_rad": lat, "python_final_lat_rad_hex": lat.hex(),
+        "python_final_tick": int(res.outputs["tick"][-1]),
+    }
+    with open(os.path.join(out_dir, "fil_dump.json"), "w") as f:
+        json.dump(info, f, indent=2)
+    return info
+
+
+def _lat_of(stdout):
+    """(ticks, lat_rad) from fil_count's line `ticks N lat X ...`."""
+    words = stdout.split()
+    return int(words[words.index("ticks") + 1]), float(words[words.index("lat") + 1])
+
+
+def _check_lat(what, stdout, info):
+    ticks, lat = _lat_of(stdout)
+    want = info["python_final_lat_rad"]
+    if ticks != info["ticks"] or struct.pack("=d", lat) != struct.pack("=d", want):
+        raise SystemExit(
+            f"FAIL: {what}: {ticks} ticks, final lat_rad {lat!r} ({lat.hex()}) but the Python run_fil "
+            f"gives {info['ticks']} ticks, {want!r} ({want.hex()}): the same inputs must give the same "
+            f"bits. Is the installed library built from the same sources as build/host? (cmake --build "
+            f"build/host && .venv/bin/python -m pip install -q -e .)")
+
+
+def _callgrind(dump_dir, toggle, out_file):
+    """Instructions collected inside ``toggle`` and the run's stdout."""
+    res = subprocess.run(["valgrind", "--tool=callgrind", f"--toggle-collect={toggle}",
+                          f"--callgrind-out-file={out_file}", str(FIL_COUNT), str(dump_dir)],
+                         capture_output=True, text=True)
+    if res.returncode != 0:
+        raise SystemExit(f"FAIL: valgrind fil_count (toggle {toggle}) exited {res.returncode}:\n"
+                         f"{res.stderr[-2000:]}")
+    for line in res.stderr.splitlines():
+        if "Collected :" in line:
+            return int(line.split(":")[-1].strip()), res.stdout
+    raise SystemExit(f"FAIL: callgrind printed no total (toggle {toggle})")
+
+
+def _inclusive(out_file, names):
+    """Inclusive instructions of the functions ``names`` in a callgrind
+    output, by callgrind_annotate --inclusive=yes (None where not listed)."""
+    res = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(out_file)],
+                         capture_output=True, text=True, check=True)
+    found = {}
+    for line in res.stdout.splitlines():     # "  221,383,443 (62.78%)  ???:pyins_run [/path/obj]"
+        mt = re.match(r"\s*([\d,]+)\s+\([^)]*\)\s+(.*?)(?:\s+\[[^\]]*\])?\s*$", line)
+        if mt is None or ":" not in mt.group(2):
+            continue
+        sym = mt.group(2).split(":", 1)[1]
+        if sym in names and sym not in found:
+            found[sym] = int(mt.group(1).replace(",", ""))
+    return {k: found.get(k) for k in names}
+
+
+def count_instructions(hours, dump_dir):
+    """Section 3: figures dict, or None (the reason printed) if it cannot run."""
+    n = int(round(hours * 3600 * TICK_HZ))
+    print(f"instruction count of the closed loop over {hours:g} h ({n:,} ticks)")
+    if shutil.which("valgrind") is None or shutil.which("callgrind_annotate") is None:
+        print("  skipped: valgrind (with callgrind_annotate) is not installed")
+        return None
+    try:  # rebuild the driver if its sources changed (a no-op otherwise)
+        subprocess.run(["cmake", "--build", str(BUILD), "--target", "fil_count"], check=True,
+                       capture_output=True, text=True)
+    except (subprocess.CalledProcessError, FileNotFoundError) as exc:
+        print(f"  skipped: build/host/fil_count did not build: "
+              f"{getattr(exc, 'stderr', '') or exc}".rstrip())
+        return None
+    t0 = time.perf_counter()
+    info = dump_inputs(dump_dir, n)
+    print(f"  inputs written to {dump_dir} ({time.perf_counter() - t0:.1f} s with the Python run); "
+          f"Python run_fil final lat_rad {info['python_final_lat_rad']!r}")
+    res = subprocess.run([str(FIL_COUNT), str(dump_dir)], capture_output=True, text=True)
+    if res.returncode != 0:
+        raise SystemExit(f"FAIL: fil_count exited {res.returncode}: {res.stderr.strip()}")
+    _check_lat("fil_count", res.stdout, info)
+    t0 = time.perf_counter()
+    out_total = BUILD / "callgrind.fil_count.out"
+    total, stdout = _callgrind(dump_dir, "pyins_fil_run", out_total)
+    _check_lat("fil_count under callgrind", stdout, info)
+    fw_alone, _ = _callgrind(dump_dir, "pyins_run", BUILD / "callgrind.fil_count.pyins_run.out")
+    incl = _inclusive(out_total, ("pyins_fil_run", "pyins_run", "pyins_get_motor_command",
+                                  "pyins_get_output"))
+    wall = time.perf_counter() - t0
+    if incl["pyins_run"] is not None and incl["pyins_run"] != fw_alone:
+        print(f"  note: pyins_run inclusive {incl['pyins_run']:,} (callgrind_annotate) vs {fw_alone:,} "
+              f"(--toggle-collect=pyins_run)")
+    getters = sum(v or 0 for k, v in incl.items() if k.startswith("pyins_get_"))
+    fig = {
+        "count_ticks": n,
+        "count_ir_per_tick_fil_run": total / n,
+        "count_ir_per_tick_firmware": fw_alone / n,
+        "count_ir_per_tick_plant": (total - fw_alone) / n,
+        "count_ir_per_tick_plant_of_which_getters": getters / n,
+        "count_firmware_share": fw_alone / total,
+        "count_ir_total_fil_run": total,
+        "count_ir_total_pyins_run": fw_alone,
+        "count_pyins_run_inclusive_annotate": incl["pyins_run"],
+        "count_final_lat_rad": info["python_final_lat_rad"],
+        "count_valgrind_wall_s": wall,
+    }
+    print(f"  fil_count reproduces run_fil's final lat_rad bit for bit (native and under callgrind)")
+    print(f"  {'instructions per tick':34s} {'Ir/tick':>10s}")
+    print(f"  {'pyins_fil_run (plant + firmware)':34s} {fig['count_ir_per_tick_fil_run']:10,.0f}")
+    print(f"  {'  firmware (pyins_run inclusive)':34s} {fig['count_ir_per_tick_firmware']:10,.0f}   "
+          f"({100 * fig['count_firmware_share']:.1f} %)")
+    print(f"  {'  plant (difference)':34s} {fig['count_ir_per_tick_plant']:10,.0f}   "
+          f"(of which pyins_get_* calls {fig['count_ir_per_tick_plant_of_which_getters']:,.0f})")
+    print(f"  (two callgrind runs: {wall:.0f} s)")
+    return fig
+
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--hours", type=float, default=72.0)
+    ap.add_argument("--hours", type=float, default=None,
+                    help="the long run's ship time (default 72 h); with --count or --dump: the counted "
+                         "run's (default 0.5 h)")
     ap.add_argument("--json", default=os.path.join("runs", "bench", "fil.json"))
     ap.add_argument("--ref-seconds", type=float, default=60.0, help="ship time the NumPy loop is timed on")
+    ap.add_argument("--count", action="store_true",
+                    help="only the callgrind instruction count (figures added to the JSON)")
+    ap.add_argument("--dump", metavar="DIR", default=None,
+                    help="where the inputs of fil_count go (alone: only write them)")
     args = ap.parse_args(argv)
-    m = sim.HeadingSwing.experiment(1)
-    errors = sim.preset("seed002")
-    cfg = dict(index_scheme=4)
+    dump_dir = args.dump or str(BUILD / "fil_dump")
+    if args.count or args.dump:
+        hours = args.hours if args.hours is not None else 0.5
+        if not args.count:
+            info = dump_inputs(dump_dir, int(round(hours * 3600 * TICK_HZ)))
+            print(f"fil_count inputs of {info['ticks']:,} ticks written to {dump_dir}; "
+                  f"Python run_fil final lat_rad {info['python_final_lat_rad']!r}")
+            return 0
+        counted = count_instructions(hours, dump_dir)
+        if counted is not None:
+            fig = {}
+            if os.path.exists(args.json):
+                with open(args.json) as f:
+                    fig = json.load(f)
+            fig.update(counted)
+            _write_json(args.json, fig)
+        return 0
+    args.hours = args.hours if args.hours is not None else 72.0
+    m, errors, cfg, _, _ = the_case()
     n = 60_000
 
     fil.run_fil(m, 1000, config=cfg, errors=errors, seed=1, every=100)   # warm-up
@@ -99,11 +314,18 @@ def main(argv=None):
     print(f"{args.hours:g} h FIL run ({ticks:,} ticks): {wall:.1f} s wall "
           f"({ticks / wall:,.0f} ticks/s), peak memory {peak_mib:.0f} MiB "
           f"(targets < 60 s, < 1024 MiB: {'met' if wall < 60 and peak_mib < 1024 else 'NOT met'})")
-    os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
-    with open(args.json, "w") as f:
-        json.dump(fig, f, indent=2)
-    print(f"figures written to {args.json}")
+    counted = count_instructions(0.5, dump_dir)
+    if counted is not None:
+        fig.update(counted)
+    _write_json(args.json, fig)
     return 0
+
+
+def _write_json(path, fig):
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump(fig, f, indent=2)
+    print(f"figures written to {path}")
 
 
 if __name__ == "__main__":
