@@ -100,28 +100,55 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
         const double a = table_accel(*table, *st, dt);
         double dtheta[3] = {0.0, 0.0, 0.0};
         double dv[3] = {0.0, 0.0, 0.0};
-        for (int32_t j = 0; j < n_nodes; ++j) {
-            const double tau = 0.5 * (1.0 + node_x[j]) * dt;
-            const double alpha = st->alpha_rad + st->rate_rad_s * tau + 0.5 * a * tau * tau;
-            const double alpha_dot = st->rate_rad_s + a * tau;
-            // a table at rest has the same angle at every node and tick: its
-            // cosine and sine are computed once (the same bits as again)
-            if (!same_bits(alpha, trig_alpha)) {
-                trig_alpha = alpha;
-                trig_c = std::cos(alpha);
-                trig_s = std::sin(alpha);
+        if (st->rate_rad_s == 0.0 && a == 0.0) {
+            // A table at rest all tick: one angle, so the rotation comes out
+            // of the quadrature, Rz^T applied once to the weighted node sums
+            // of the ship's rate and force (most ticks of a rotation scheme).
+            if (!same_bits(st->alpha_rad, trig_alpha)) {
+                trig_alpha = st->alpha_rad;
+                trig_c = std::cos(trig_alpha);
+                trig_s = std::sin(trig_alpha);
+            }
+            double w_sum[3] = {0.0, 0.0, 0.0};
+            double f_sum[3] = {0.0, 0.0, 0.0};
+            for (int32_t j = 0; j < n_nodes; ++j) {
+                const double* w_b = node_omega_b + 3 * (base + j);
+                const double* f_b = node_force_b + 3 * (base + j);
+                for (int i = 0; i < 3; ++i) {
+                    w_sum[i] = w_sum[i] + node_w[j] * w_b[i];
+                    f_sum[i] = f_sum[i] + node_w[j] * f_b[i];
+                }
             }
             const double c = trig_c;
             const double s = trig_s;
-            const double* w_b = node_omega_b + 3 * (base + j);
-            const double* f_b = node_force_b + 3 * (base + j);
-            // omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot z;  f^p = Rz(alpha)^T f^b
-            dtheta[0] = dtheta[0] + node_w[j] * (c * w_b[0] + s * w_b[1]);
-            dtheta[1] = dtheta[1] + node_w[j] * (-s * w_b[0] + c * w_b[1]);
-            dtheta[2] = dtheta[2] + node_w[j] * (w_b[2] + alpha_dot);
-            dv[0] = dv[0] + node_w[j] * (c * f_b[0] + s * f_b[1]);
-            dv[1] = dv[1] + node_w[j] * (-s * f_b[0] + c * f_b[1]);
-            dv[2] = dv[2] + node_w[j] * f_b[2];
+            dtheta[0] = c * w_sum[0] + s * w_sum[1];
+            dtheta[1] = -s * w_sum[0] + c * w_sum[1];
+            dtheta[2] = w_sum[2];
+            dv[0] = c * f_sum[0] + s * f_sum[1];
+            dv[1] = -s * f_sum[0] + c * f_sum[1];
+            dv[2] = f_sum[2];
+        } else {
+            for (int32_t j = 0; j < n_nodes; ++j) {
+                const double tau = 0.5 * (1.0 + node_x[j]) * dt;
+                const double alpha = st->alpha_rad + st->rate_rad_s * tau + 0.5 * a * tau * tau;
+                const double alpha_dot = st->rate_rad_s + a * tau;
+                if (!same_bits(alpha, trig_alpha)) {
+                    trig_alpha = alpha;
+                    trig_c = std::cos(alpha);
+                    trig_s = std::sin(alpha);
+                }
+                const double c = trig_c;
+                const double s = trig_s;
+                const double* w_b = node_omega_b + 3 * (base + j);
+                const double* f_b = node_force_b + 3 * (base + j);
+                // omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot z;  f^p = Rz(alpha)^T f^b
+                dtheta[0] = dtheta[0] + node_w[j] * (c * w_b[0] + s * w_b[1]);
+                dtheta[1] = dtheta[1] + node_w[j] * (-s * w_b[0] + c * w_b[1]);
+                dtheta[2] = dtheta[2] + node_w[j] * (w_b[2] + alpha_dot);
+                dv[0] = dv[0] + node_w[j] * (c * f_b[0] + s * f_b[1]);
+                dv[1] = dv[1] + node_w[j] * (-s * f_b[0] + c * f_b[1]);
+                dv[2] = dv[2] + node_w[j] * f_b[2];
+            }
         }
         for (int i = 0; i < 3; ++i) {
             dtheta[i] = half * dtheta[i];

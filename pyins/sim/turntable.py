@@ -154,18 +154,30 @@ def plant_tick(cfg, st, errors, omega_b, force_b, x, w, gyro_noise, accel_noise,
     # 1. The motor's acceleration over the tick (constant within it).
     a = table_accel(cfg, st, dt)
     # 2. The increments: omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot z,
-    #    f^p = Rz(alpha)^T f^b, integrated over the tick by Gauss-Legendre.
-    dtheta = np.zeros(3)
-    dv = np.zeros(3)
-    for j in range(len(x)):
-        tau = 0.5 * (1.0 + x[j]) * dt
-        alpha = st.alpha_rad + st.rate_rad_s * tau + 0.5 * a * tau * tau
-        alpha_dot = st.rate_rad_s + a * tau
-        c, s = np.cos(alpha), np.sin(alpha)
-        wb, fb = omega_b[j], force_b[j]
-        dtheta = dtheta + w[j] * np.array([c * wb[0] + s * wb[1], -s * wb[0] + c * wb[1],
-                                           wb[2] + alpha_dot])
-        dv = dv + w[j] * np.array([c * fb[0] + s * fb[1], -s * fb[0] + c * fb[1], fb[2]])
+    #    f^p = Rz(alpha)^T f^b, integrated over the tick by Gauss-Legendre
+    #    (at rest, one alpha: Rz^T once on the weighted sums).
+    if st.rate_rad_s == 0.0 and a == 0.0:
+        # a table at rest all tick: Rz^T once on the weighted node sums
+        c, s = np.cos(st.alpha_rad), np.sin(st.alpha_rad)
+        w_sum = np.zeros(3)
+        f_sum = np.zeros(3)
+        for j in range(len(x)):
+            w_sum = w_sum + w[j] * omega_b[j]
+            f_sum = f_sum + w[j] * force_b[j]
+        dtheta = np.array([c * w_sum[0] + s * w_sum[1], -s * w_sum[0] + c * w_sum[1], w_sum[2]])
+        dv = np.array([c * f_sum[0] + s * f_sum[1], -s * f_sum[0] + c * f_sum[1], f_sum[2]])
+    else:
+        dtheta = np.zeros(3)
+        dv = np.zeros(3)
+        for j in range(len(x)):
+            tau = 0.5 * (1.0 + x[j]) * dt
+            alpha = st.alpha_rad + st.rate_rad_s * tau + 0.5 * a * tau * tau
+            alpha_dot = st.rate_rad_s + a * tau
+            c, s = np.cos(alpha), np.sin(alpha)
+            wb, fb = omega_b[j], force_b[j]
+            dtheta = dtheta + w[j] * np.array([c * wb[0] + s * wb[1], -s * wb[0] + c * wb[1],
+                                               wb[2] + alpha_dot])
+            dv = dv + w[j] * np.array([c * fb[0] + s * fb[1], -s * fb[0] + c * fb[1], fb[2]])
     dtheta = half * dtheta
     dv = half * dv
     # 3. The table at the end of the tick.
