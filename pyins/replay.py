@@ -110,6 +110,7 @@ class _Summary:
         self.last = self.first_nav = self.last_fine = None
         self.horizontal_max = self.level_max = self.speed_max = -np.inf
         self.e_last = None
+        self.t_span = None        # the records' times on a truth track's clock [s]
 
     def add(self, recs):
         self.records += len(recs)
@@ -142,6 +143,8 @@ class _Summary:
             t = ticks / self.hz if self.t_first is None else self.t_first + (ticks - 1.0) / self.hz
             inside, err = self.reference.errors(t, recs["lat_rad"], recs["lon_rad"], recs["heading_b_rad"])
             self.outside += int(np.count_nonzero(~inside))
+            lo, hi = float(t.min()), float(t.max())
+            self.t_span = (lo, hi) if self.t_span is None else (min(self.t_span[0], lo), max(self.t_span[1], hi))
             if not inside.any():
                 return
             err["time_s"] = ticks[inside] / self.hz           # since the log's start, as the others
@@ -189,8 +192,9 @@ class _Summary:
         elif isinstance(self.reference, TruthTrack):
             track = self.reference
             if self.e_last is None:
+                span = "" if self.t_span is None else f"; the records span {self.t_span[0]:g} .. {self.t_span[1]:g} s"
                 summary["warnings"].append(f"no record lies within the time span of {track.path} "
-                                           f"({track.t[0]:g} .. {track.t[-1]:g} s): no errors computed")
+                                           f"({track.t[0]:g} .. {track.t[-1]:g} s{span}): no errors computed")
             else:
                 summary["errors"] = dict(reference=f"the track in {os.path.basename(track.path)}",
                                          horizontal_max_m=self.horizontal_max,

@@ -142,3 +142,20 @@ def test_the_real_log_against_a_track_of_its_site_is_the_parked_reference(tmp_pa
     s = json.loads((out_t / "summary.json").read_text())
     assert abs(s["errors"]["heading_final_arcmin"]) < 30.0
     assert s["errors"]["compared"] == len(et["time_s"]) == 300
+
+
+def test_a_track_that_covers_no_record_is_not_a_success(demo, tmp_path, capsys):
+    # another day's track (its clock 1e6 s later): nothing can be compared,
+    # so the errors the user asked for do not exist; the records stay written
+    d, log, spec = demo
+    track = _track(tmp_path / "t.csv", spec, log)
+    lines = track.read_text().splitlines()
+    shifted = [lines[0], lines[1]] + [", ".join([f"{float(r.split(',')[0]) + 1e6:.6f}"] + r.split(",")[1:])
+                                      for r in lines[2:]]
+    track.write_text("\n".join(shifted) + "\n")
+    out = tmp_path / "o"
+    rc = cli.main(["replay", str(log), "--out", str(out), "--quiet", "--scenario", "demo", "--truth", str(track)])
+    assert rc == cli.EXIT_INPUT
+    err = capsys.readouterr().err
+    assert "no record lies within the time span" in err and "the records span" in err
+    assert (out / "navigation.npz").exists() and (out / "summary.json").exists()
