@@ -18,6 +18,7 @@ import pytest
 
 from pyins import __main__ as cli
 from pyins import runs, scenario
+from pyins.records import PLANT_RECORD_DTYPE
 
 #: How long after SIGINT a command may take to exit. The brief is "a second
 #: or two"; 5 s leaves room for a machine shared with other jobs (the stop
@@ -112,8 +113,12 @@ def test_kill_9_leaves_a_directory_the_report_reads_and_resume_completes(tmp_pat
     out = tmp_path / "r"
     args = ("run", "seed003", "--hours", "12", "--out", str(out), "--quiet")
     proc = _start(*args)
-    bin_ = out / "no_rotation" / "records" / "outputs.bin"
-    _wait_for(proc, lambda: bin_.exists() and bin_.stat().st_size > 0, "records on disk")
+    rec_dir = out / "no_rotation" / "records"
+    # a whole record in both files (outputs.bin is written first: a kill
+    # between the two writes leaves no record the report can pair)
+    plant_bin = rec_dir / "plant.bin"
+    _wait_for(proc, lambda: (rec_dir / "outputs.bin").exists() and plant_bin.exists()
+              and plant_bin.stat().st_size >= PLANT_RECORD_DTYPE.itemsize, "records on disk")
     rc, _, _ = _stop(proc, signal.SIGKILL)
     assert rc == -signal.SIGKILL
     rc, rep = _report(out, capsys)
