@@ -281,32 +281,25 @@ def core_timers(cfg, samples):
         if status != 0 or nd[0] != n:
             raise RuntimeError(f"{name}: status {status}, {nd[0]} of {n} samples")
 
-    def null_outputs():
+    def timed(name, call):
+        """Seconds of one call(core) on a fresh core (its init not timed)."""
         fw = native.Firmware(cfg)   # keep fw: it owns the core's memory
         core = fw.core
         t0 = time.perf_counter()
-        status = lib.pyins_run(core, sample_ptr, n, ffi.NULL, nd)
+        status = call(core)
         t = time.perf_counter() - t0
-        check(status, "pyins_run(NULL)")
+        check(status, name)
         return t
+
+    def null_outputs():
+        return timed("pyins_run(NULL)", lambda core: lib.pyins_run(core, sample_ptr, n, ffi.NULL, nd))
 
     def every_100():
-        fw = native.Firmware(cfg)   # keep fw: it owns the core's memory
-        core = fw.core
-        t0 = time.perf_counter()
-        status = lib.pyins_run_decimated(core, sample_ptr, n, 100, dec_ptr, cap, nd, n_out)
-        t = time.perf_counter() - t0
-        check(status, "pyins_run_decimated(100)")
-        return t
+        return timed("pyins_run_decimated(100)",
+                     lambda core: lib.pyins_run_decimated(core, sample_ptr, n, 100, dec_ptr, cap, nd, n_out))
 
     def every_tick():
-        fw = native.Firmware(cfg)   # keep fw: it owns the core's memory
-        core = fw.core
-        t0 = time.perf_counter()
-        status = lib.pyins_run(core, sample_ptr, n, out_ptr, nd)
-        t = time.perf_counter() - t0
-        check(status, "pyins_run")
-        return t
+        return timed("pyins_run", lambda core: lib.pyins_run(core, sample_ptr, n, out_ptr, nd))
 
     return {"core_null_outputs": null_outputs, "core_every_100": every_100,
             "core_every_tick": every_tick}
