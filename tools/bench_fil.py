@@ -7,11 +7,13 @@
 
 1. A 10-minute closed-loop run (seed 002 experiment 1, flexible scheme,
    seed 002 sensor errors) three ways: compiled plant + C++ firmware
-   (pyins_fil_run), the C++ firmware alone on the same samples (batch call),
-   and the NumPy plant + NumPy reference firmware; ticks per second and the
-   ratios. The compiled plant's own cost is the difference of the first two.
+   (pyins_fil_run), the C++ firmware alone on samples of the same kind
+   (batch call, a record every 100 ticks as the loop keeps them), and the
+   NumPy plant + NumPy reference firmware; ticks per second and the ratios.
+   The compiled plant's own cost is counted, not timed (3.).
 2. The full --hours run (default 72 h = 25.9 M ticks) through run_fil:
-   wall time and peak memory (target < 60 s and < 1 GiB).
+   wall time and peak memory (issue 15's targets: < 6 s on a quiet machine,
+   < 500 MiB).
 3. (``--count``, also at the end of the default run) the machine-independent
    cost: valgrind callgrind's instructions per tick inside pyins_fil_run
    (plant + firmware), of which inside pyins_run (the firmware; the plant is
@@ -262,7 +264,7 @@ def main(argv=None):
     samples = native.make_samples(dth, dv, al)
     fw = native.Firmware(scenario.initial_config(m, None, **cfg))
     t0 = time.perf_counter()
-    fw.run(samples)
+    fw.run(samples, every=100)          # records as the closed loop keeps them
     t_fw = time.perf_counter() - t0
     # the NumPy loop
     k = int(args.ref_seconds * TICK_HZ)
@@ -285,7 +287,6 @@ def main(argv=None):
     fig = {
         "fil_cpp_ticks_per_s": n / t_fil,
         "firmware_cpp_ticks_per_s": n / t_fw,
-        "plant_cpp_ticks_per_s_derived": n / max(t_fil - t_fw, 1e-9),
         "fil_numpy_ticks_per_s": n / t_ref,
         "plant_numpy_ticks_per_s": n / t_plant_ref,
         "firmware_numpy_ticks_per_s": n / (t_ref - t_plant_ref),
@@ -295,7 +296,7 @@ def main(argv=None):
     print(f"{'':34s} {'ticks/s':>12s}")
     print(f"{'C++ plant + C++ firmware':34s} {fig['fil_cpp_ticks_per_s']:12,.0f}")
     print(f"{'C++ firmware alone':34s} {fig['firmware_cpp_ticks_per_s']:12,.0f}")
-    print(f"{'C++ plant alone (difference)':34s} {fig['plant_cpp_ticks_per_s_derived']:12,.0f}")
+    print(f"{'C++ plant alone':34s} {'see --count':>12s}   (a difference of two wall times is noise here)")
     print(f"{'NumPy plant + NumPy firmware':34s} {fig['fil_numpy_ticks_per_s']:12,.0f}   "
           f"(timed on {args.ref_seconds:g} s)")
     print(f"{'NumPy plant alone':34s} {fig['plant_numpy_ticks_per_s']:12,.0f}")
@@ -303,17 +304,21 @@ def main(argv=None):
     print(f"ratio C++ / NumPy closed loop: {fig['ratio_cpp_vs_numpy_fil']:,.0f}x")
 
     ticks = int(round(args.hours * 3600 * TICK_HZ))
+    load_before = os.getloadavg()[0]
     t0 = time.perf_counter()
     res = fil.run_fil(m, ticks, config=cfg, errors=errors, seed=1, every=100)
     wall = time.perf_counter() - t0
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     e = metrics.nav_errors(res)
     fig.update({"long_run_hours": args.hours, "long_run_ticks": ticks, "long_run_wall_s": wall,
+                "long_run_load_1min_before": load_before,
                 "long_run_ticks_per_s": ticks / wall, "peak_memory_mib": peak_mib,
                 "long_run_max_horizontal_error_m": float(e.horizontal_m.max())})
     print(f"{args.hours:g} h FIL run ({ticks:,} ticks): {wall:.1f} s wall "
           f"({ticks / wall:,.0f} ticks/s), peak memory {peak_mib:.0f} MiB "
-          f"(targets < 60 s, < 1024 MiB: {'met' if wall < 60 and peak_mib < 1024 else 'NOT met'})")
+          f"at a load of {load_before:.2f}; targets (72 h, quiet machine) < 6 s and < 500 MiB: "
+          f"wall {'met' if wall < 6.0 * args.hours / 72.0 else 'NOT met'}, "
+          f"memory {'met' if peak_mib < 500 else 'NOT met'}")
     counted = count_instructions(0.5, dump_dir)
     if counted is not None:
         fig.update(counted)
