@@ -193,8 +193,9 @@ class _Summary:
             track = self.reference
             if self.e_last is None:
                 span = "" if self.t_span is None else f"; the records span {self.t_span[0]:g} .. {self.t_span[1]:g} s"
-                summary["warnings"].append(f"no record lies within the time span of {track.path} "
-                                           f"({track.t[0]:g} .. {track.t[-1]:g} s{span}): no errors computed")
+                summary["errors_missing"] = (f"no record lies within the time span of {track.path} "
+                                             f"({track.t[0]:g} .. {track.t[-1]:g} s{span}): no errors computed")
+                summary["warnings"].append(summary["errors_missing"])
             else:
                 summary["errors"] = dict(reference=f"the track in {os.path.basename(track.path)}",
                                          horizontal_max_m=self.horizontal_max,

@@ -95,6 +95,15 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
     double trig_alpha = std::numeric_limits<double>::quiet_NaN();  // no angle yet
     double trig_c = 1.0;
     double trig_s = 0.0;
+    // cos and sin of the table angle, taken again only when it moved (a
+    // table at rest has the same angle at every node and tick: the same bits)
+    auto trig = [&](double alpha) {
+        if (!same_bits(alpha, trig_alpha)) {
+            trig_alpha = alpha;
+            trig_c = std::cos(alpha);
+            trig_s = std::sin(alpha);
+        }
+    };
     for (size_t k = 0; k < n; ++k) {
         const int64_t base = ((phase0 + static_cast<int64_t>(k)) % period) * n_nodes;
         const double a = table_accel(*table, *st, dt);
@@ -104,11 +113,7 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
             // A table at rest all tick: one angle, so the rotation comes out
             // of the quadrature, Rz^T applied once to the weighted node sums
             // of the ship's rate and force (most ticks of a rotation scheme).
-            if (!same_bits(st->alpha_rad, trig_alpha)) {
-                trig_alpha = st->alpha_rad;
-                trig_c = std::cos(trig_alpha);
-                trig_s = std::sin(trig_alpha);
-            }
+            trig(st->alpha_rad);
             double w_sum[3] = {0.0, 0.0, 0.0};
             double f_sum[3] = {0.0, 0.0, 0.0};
             for (int32_t j = 0; j < n_nodes; ++j) {
@@ -132,11 +137,7 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
                 const double tau = 0.5 * (1.0 + node_x[j]) * dt;
                 const double alpha = st->alpha_rad + st->rate_rad_s * tau + 0.5 * a * tau * tau;
                 const double alpha_dot = st->rate_rad_s + a * tau;
-                if (!same_bits(alpha, trig_alpha)) {
-                    trig_alpha = alpha;
-                    trig_c = std::cos(alpha);
-                    trig_s = std::sin(alpha);
-                }
+                trig(alpha);
                 const double c = trig_c;
                 const double s = trig_s;
                 const double* w_b = node_omega_b + 3 * (base + j);

@@ -9,7 +9,6 @@
 // Shepperd (1978), J. Guidance 1(3) (quaternion from a rotation matrix).
 #pragma once
 
-#include "math_portable.hpp"
 #include "types.hpp"
 
 namespace pyins::attitude {

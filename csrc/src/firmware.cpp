@@ -16,12 +16,6 @@ using angle::wrap_two_pi;
 
 namespace {
 
-/// Some component at or beyond the limit: an IMU at full scale is saturated
-/// (its true increment is unknown), so the limit itself counts.
-bool saturated3(const double v[3], double limit) {
-    return std::fabs(v[0]) >= limit || std::fabs(v[1]) >= limit || std::fabs(v[2]) >= limit;
-}
-
 /// Every component finite and inside the limit (a NaN compares false).
 bool within(const double v[3], double limit) {
     return std::fabs(v[0]) < limit && std::fabs(v[1]) < limit && std::fabs(v[2]) < limit;
@@ -162,10 +156,10 @@ void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
         cb = c11 / h;
         sb = -c01 / h;
     }
-    // psi_p = psi_b + alpha by the angle sum, alpha from the encoder's cached
-    // half-angle (cos a = c^2 - s^2, sin a = 2 s c)
-    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
-    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
+    // psi_p = psi_b + alpha by the angle sum
+    double sa;
+    double ca;
+    encoder_sincos(&sa, &ca);
     *cos_yaw_p = cb * ca - sb * sa;
     *sin_yaw_p = sb * ca + cb * sa;
 }
@@ -188,11 +182,17 @@ void Firmware::update_rates(const Vec3& dtheta_p, double dalpha) {
     }
 }
 
+void Firmware::encoder_sincos(double* sin_alpha, double* cos_alpha) const {
+    // from the cached half-angle: sin a = 2 s c, cos a = c^2 - s^2
+    *sin_alpha = 2.0 * enc_sin_half_ * enc_cos_half_;
+    *cos_alpha = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+}
+
 Vec3 Firmware::lever_b_in_p() const {
-    // Rz(alpha)^T lever_b, alpha = the encoder angle, from its cached
-    // half-angle (cos a = c^2 - s^2, sin a = 2 s c).
-    const double sa = 2.0 * enc_sin_half_ * enc_cos_half_;
-    const double ca = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
+    // Rz(alpha)^T lever_b, alpha = the encoder angle
+    double sa;
+    double ca;
+    encoder_sincos(&sa, &ca);
     const double* lb = cfg_.lever_b_m;
     return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
 }
@@ -492,10 +492,9 @@ SeqStep Firmware::seq_step(uint32_t seq) const {
 }
 
 bool Firmware::usable(const pyins_sample& sample) const {
-    return finite3(sample.dtheta_p_rad) && finite3(sample.dv_p_mps) &&
-           std::isfinite(sample.table_angle_rad) &&
-           !saturated3(sample.dtheta_p_rad, cfg_.sat_gyro_rad) &&
-           !saturated3(sample.dv_p_mps, cfg_.sat_accel_mps);
+    // one pass: |v| < limit is false for a NaN and an infinity too
+    return within(sample.dtheta_p_rad, cfg_.sat_gyro_rad) && within(sample.dv_p_mps, cfg_.sat_accel_mps) &&
+           std::isfinite(sample.table_angle_rad);
 }
 
 int64_t Firmware::ticks_for(const pyins_sample& sample) const {
@@ -528,11 +527,8 @@ int Firmware::reject_sample(const pyins_sample& sample, pyins_output* out) {
 int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     // docs/core.md, "Sample-level faults": the checks in this order.
     // 1. Reject a non-finite sample, then a saturated one. A good sample
-    //    passes both in one test (|v| < limit is false for a NaN and an
-    //    infinity too); only a sample that fails it is told apart.
-    const bool good = within(sample.dtheta_p_rad, cfg_.sat_gyro_rad) &&
-                      within(sample.dv_p_mps, cfg_.sat_accel_mps) && std::isfinite(sample.table_angle_rad);
-    if (!good) {
+    //    passes both in one test (usable); only one that fails it is told apart.
+    if (!usable(sample)) {
         return reject_sample(sample, out);
     }
     // 2. The sequence: drop a duplicate; note a gap or a resynchronisation.

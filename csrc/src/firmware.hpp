@@ -96,11 +96,11 @@ class Firmware {
     /// increments interpolated linearly between the last sample taken and
     /// this one, the encoder along the shortest turn between their readings.
     void bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
-    /// A rejected sample: sticky bit, counter, and an alignment restart.
-    /// Step 1's slow path, for a sample that failed the one-pass test: a
-    /// non-finite one, else a saturated one (the limits are finite and > 0,
+    /// Step 1's slow path, for a sample usable() refused: a non-finite one,
+    /// else a saturated one (the limits are finite and > 0,
     /// config::config_check), rejected with its fault bit and counter.
     int reject_sample(const pyins_sample& sample, pyins_output* out);
+    /// A rejected sample: sticky bit, counter, and an alignment restart.
     void reject(uint32_t fault_bit, uint32_t* counter);
     /// Leave coarse alignment for fine alignment or navigation.
     void end_coarse();
@@ -123,6 +123,8 @@ class Firmware {
     /// Lever arm (docs/concepts.md, "Lever arms"): rate estimates at the end
     /// of this tick from its increments and the last tick's.
     void update_rates(const Vec3& dtheta_p, double dalpha);
+    /// sin and cos of the encoder angle alpha, from its cached half-angle.
+    void encoder_sincos(double* sin_alpha, double* cos_alpha) const;
     /// Rz(alpha)^T lever_b: the table centre from the reference point, in p [m].
     Vec3 lever_b_in_p() const;
     /// r^p = Rz(alpha)^T lever_b + lever_p: reference point -> accelerometers, in p [m].

@@ -31,9 +31,10 @@ COUNTERS = ("n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_
             "n_seq_lost", "n_encoder_jumps")   #: SampleCounts, as named in pyins_output
 
 
-def saturated3(v, limit):
-    """Some component at or beyond the limit (mirrors saturated3)."""
-    return abs(v[0]) >= limit or abs(v[1]) >= limit or abs(v[2]) >= limit
+def within(v, limit):
+    """Every component finite and inside the limit, a NaN comparing false
+    (mirrors within)."""
+    return abs(v[0]) < limit and abs(v[1]) < limit and abs(v[2]) < limit
 
 
 def count(counter, n=1):
@@ -150,8 +151,7 @@ class Firmware:
         if h > 0.0:
             cb = c11 / h
             sb = -c01 / h
-        ca = self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half
-        sa = 2.0 * self.enc_sin_half * self.enc_cos_half
+        sa, ca = self.encoder_sincos()
         return sb * ca + cb * sa, cb * ca - sb * sa
 
     def update_rates(self, dtheta_p, dalpha):
@@ -167,10 +167,15 @@ class Firmware:
         if self.rate_count < 2:
             self.rate_count = self.rate_count + 1
 
+    def encoder_sincos(self):
+        """sin and cos of the encoder angle from its cached half-angle
+        (mirrors encoder_sincos)."""
+        return (2.0 * self.enc_sin_half * self.enc_cos_half,
+                self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half)
+
     def lever_b_in_p(self):
-        """Rz(alpha)^T lever_b from the cached half-angle."""
-        sa = 2.0 * self.enc_sin_half * self.enc_cos_half
-        ca = self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half
+        """Rz(alpha)^T lever_b (mirrors lever_b_in_p)."""
+        sa, ca = self.encoder_sincos()
         lb = self.lever_b
         return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
 
@@ -365,9 +370,16 @@ class Firmware:
 
     def usable(self, dtheta_p, dv_p, table_angle_rad):
         """Finite and within the saturation limits (mirrors Firmware::usable)."""
-        return (finite3(dtheta_p) and finite3(dv_p) and math.isfinite(table_angle_rad)
-                and not saturated3(dtheta_p, self.cfg["sat_gyro_rad"])
-                and not saturated3(dv_p, self.cfg["sat_accel_mps"]))
+        return (within(dtheta_p, self.cfg["sat_gyro_rad"]) and within(dv_p, self.cfg["sat_accel_mps"])
+                and math.isfinite(table_angle_rad))
+
+    def reject_sample(self, dtheta_p, dv_p, table_angle_rad):
+        """Step 1's slow path: non-finite, else saturated (mirrors reject_sample)."""
+        if not (finite3(dtheta_p) and finite3(dv_p) and math.isfinite(table_angle_rad)):
+            self.reject(abi.PYINS_FAULT_SAMPLE_NONFINITE, "n_nonfinite")
+            return abi.PYINS_E_SAMPLE_NONFINITE, self.output()
+        self.reject(abi.PYINS_FAULT_SAMPLE_SATURATED, "n_saturated")
+        return abi.PYINS_E_SAMPLE_SATURATED, self.output()
 
     def ticks_for(self, dtheta_p, dv_p, table_angle_rad, seq=0):
         """Ticks stepping this sample would add (0: rejected or dropped); changes nothing."""
@@ -381,13 +393,9 @@ class Firmware:
 
         ``seq`` is the IMU's sample counter (read with ``seq_mode`` = abi.PYINS_SEQ_CHECK).
         """
-        # 1. Reject a non-finite sample, then a saturated one.
-        if not (finite3(dtheta_p) and finite3(dv_p) and math.isfinite(table_angle_rad)):
-            self.reject(abi.PYINS_FAULT_SAMPLE_NONFINITE, "n_nonfinite")
-            return abi.PYINS_E_SAMPLE_NONFINITE, self.output()
-        if saturated3(dtheta_p, self.cfg["sat_gyro_rad"]) or saturated3(dv_p, self.cfg["sat_accel_mps"]):
-            self.reject(abi.PYINS_FAULT_SAMPLE_SATURATED, "n_saturated")
-            return abi.PYINS_E_SAMPLE_SATURATED, self.output()
+        # 1. Reject a non-finite sample, then a saturated one (one test, usable).
+        if not self.usable(dtheta_p, dv_p, table_angle_rad):
+            return self.reject_sample(dtheta_p, dv_p, table_angle_rad)
         # 2. The sequence: drop a duplicate; note a gap or a resynchronisation.
         seq = int(seq) & U32
         status = abi.PYINS_OK
