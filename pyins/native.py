@@ -20,7 +20,7 @@ import numpy as np
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 11)
+EXPECTED_ABI = (0, 12)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")
@@ -117,6 +117,8 @@ SAMPLE_DTYPE = _numpy_dtype("pyins_sample")
 #: Statuses that reject a sample (batch calls stop there; SampleError).
 _SAMPLE_REJECTED = (lib.PYINS_E_SAMPLE_NONFINITE, lib.PYINS_E_SAMPLE_SATURATED)
 OUTPUT_DTYPE = _numpy_dtype("pyins_output")
+#: The compact record (pyins_nav): OUTPUT_DTYPE's fields of the same names.
+NAV_DTYPE = _numpy_dtype("pyins_nav")
 CONFIG_FIELDS = tuple(name for name, _ in ffi.typeof("pyins_config").fields)
 
 VERTICAL_MODES = {"hold": 0, "free": 1}
@@ -300,9 +302,14 @@ class Firmware:
         self._n_done = ffi.new("size_t *")
         self.last_status = 0
 
-    def _run_decimated(self, samples, every):
+    def _run_decimated(self, samples, every, compact=False):
         if every < 1:
             raise ValueError(f"every: must be a positive number of ticks, got {every}")
+        if compact:
+            call, name, dtype, ctype = lib.pyins_run_nav, "pyins_run_nav", NAV_DTYPE, "pyins_nav *"
+        else:
+            call, name, dtype, ctype = (lib.pyins_run_decimated, "pyins_run_decimated", OUTPUT_DTYPE,
+                                        "pyins_output *")
         n = samples.shape[0]
         n_done = ffi.new("size_t *")
         n_out = ffi.new("size_t *")
@@ -311,10 +318,10 @@ class Firmware:
         while True:
             rest = samples[start:]
             capacity = (n - start) // every + 1
-            outputs = np.empty(capacity, dtype=OUTPUT_DTYPE)
-            status = lib.pyins_run_decimated(
+            outputs = np.empty(capacity, dtype=dtype)
+            status = call(
                 self._core, ffi.cast("pyins_sample *", ffi.from_buffer(rest)), n - start, every,
-                ffi.cast("pyins_output *", ffi.from_buffer(outputs, require_writable=True)), capacity,
+                ffi.cast(ctype, ffi.from_buffer(outputs, require_writable=True)), capacity,
                 n_done, n_out)
             parts.append(outputs[: n_out[0]])
             start += int(n_done[0])
@@ -327,8 +334,24 @@ class Firmware:
         if status != 0:
             if status in _SAMPLE_REJECTED:
                 raise SampleError(status, start, records.copy())
-            raise CoreError(status, "pyins_run_decimated")
+            raise CoreError(status, name)
         return records
+
+    def run_nav(self, samples, every=1):
+        """As ``run``, with the compact record: a NAV_DTYPE array, one record
+        after each step whose tick is a multiple of ``every`` (1: every
+        step that advances the tick). Its fields are OUTPUT_DTYPE's of the
+        same names, bit for bit, at less than a fifth of a full record's
+        cost (pyins_run_nav)."""
+        return self._run_decimated(_check_samples(samples), int(every), compact=True)
+
+    def nav(self):
+        """The current state as one NAV_DTYPE record (pyins_get_nav)."""
+        rec = np.zeros(1, dtype=NAV_DTYPE)
+        status = lib.pyins_get_nav(self._core, ffi.cast("pyins_nav *", ffi.from_buffer(rec, require_writable=True)))
+        if status != 0:
+            raise CoreError(status, "pyins_get_nav")
+        return rec[0].copy()
 
     def snapshot(self):
         """The whole firmware state as a versioned, checksummed blob (bytes)."""

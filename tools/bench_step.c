@@ -9,6 +9,7 @@
  *   run       pyins_run, blocks of 100 samples, a full record every tick
  *   null      pyins_run, blocks of 100 samples, no records (outputs NULL)
  *   every100  pyins_run_decimated, blocks of 100 samples, one record per block
+ *   compact   pyins_run_nav, blocks of 100 samples, a compact record (pyins_nav) every tick
  * In the block modes the encoder reads back the command of the block's last
  * record (pyins_get_output between blocks, outside the counted function).
  * tools/bench_strapdown.py, tools/bench_alignment.py and tools/size_report.py
@@ -20,7 +21,7 @@
 #include "bench_modes.h"
 #include "pyins_core.h"
 
-enum { API_STEP, API_RUN, API_NULL, API_EVERY100 };
+enum { API_STEP, API_RUN, API_NULL, API_EVERY100, API_COMPACT };
 #define BLOCK 100
 
 int main(int argc, char **argv) {
@@ -31,6 +32,7 @@ int main(int argc, char **argv) {
     static unsigned char mem[1 << 14] __attribute__((aligned(64)));
     static pyins_sample block[BLOCK];
     static pyins_output records[BLOCK + 1];
+    static pyins_nav navs[BLOCK + 1];
     pyins_config cfg;
     pyins_sample s;
     pyins_output out;
@@ -40,8 +42,9 @@ int main(int argc, char **argv) {
     else if (strcmp(api_name, "run") == 0) api = API_RUN;
     else if (strcmp(api_name, "null") == 0) api = API_NULL;
     else if (strcmp(api_name, "every100") == 0) api = API_EVERY100;
+    else if (strcmp(api_name, "compact") == 0) api = API_COMPACT;
     else {
-        fprintf(stderr, "unknown API %s (step, run, null, every100)\n", api_name);
+        fprintf(stderr, "unknown API %s (step, run, null, every100, compact)\n", api_name);
         return 2;
     }
     if (pyins_core_size() > sizeof mem) {
@@ -67,7 +70,9 @@ int main(int argc, char **argv) {
             long k;
             int st;
             for (k = 0; k < m; ++k) bench_sample(mode, i + k, out.table_angle_cmd_rad, &block[k]);
-            if (api == API_EVERY100) {
+            if (api == API_COMPACT) {
+                st = pyins_run_nav((pyins_core *)mem, block, (size_t)m, 1, navs, BLOCK + 1, &done, &n_out);
+            } else if (api == API_EVERY100) {
                 st = pyins_run_decimated((pyins_core *)mem, block, (size_t)m, BLOCK, records, BLOCK + 1,
                                          &done, &n_out);
             } else {

@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 11
+#define PYINS_ABI_VERSION_MINOR 12
 
 #ifdef __cplusplus
 extern "C" {
@@ -346,6 +346,29 @@ typedef struct pyins_motor_command {
     int32_t index_fault;          /* = pyins_output.index_fault */
 } pyins_motor_command;
 
+/* The navigation solution alone, for a caller that wants it often (a
+ * replay or a closed loop at the full rate): the fields of pyins_output of
+ * the same names, bit for bit, without the Euler angles, the heading, the
+ * alignment filter's state and the counters, whose derivation costs as much
+ * as the navigation tick (pyins_run_nav, pyins_get_nav). 160 bytes against
+ * pyins_output's 432. */
+typedef struct pyins_nav {
+    int64_t tick;                 /* = pyins_output.tick */
+    int32_t mode;                 /* = pyins_output.mode (enum pyins_mode) */
+    uint32_t fault_flags;         /* = pyins_output.fault_flags */
+    uint32_t state_flags;         /* = pyins_output.state_flags */
+    int32_t index_state;          /* = pyins_output.index_state */
+    double lat_rad;               /* = pyins_output.lat_rad: the reference point's */
+    double lon_rad;               /* = pyins_output.lon_rad */
+    double height_m;              /* = pyins_output.height_m */
+    double vel_n_mps[3];          /* = pyins_output.vel_n_mps, ENU [m/s] */
+    double quat_nb[4];            /* = pyins_output.quat_nb: ship attitude C_b^n, w >= 0 */
+    double quat_np[4];            /* = pyins_output.quat_np: IMU attitude C_p^n, w >= 0 */
+    double table_angle_rad;       /* = pyins_output.table_angle_rad */
+    double motor_rate_cmd_rad_s;  /* = pyins_output.motor_rate_cmd_rad_s */
+    double table_angle_cmd_rad;   /* = pyins_output.table_angle_cmd_rad */
+} pyins_nav;
+
 /* The firmware instance. Opaque: it lives in caller memory of
  * pyins_core_size() bytes aligned to pyins_core_align(). */
 typedef struct pyins_core pyins_core;
@@ -364,6 +387,7 @@ size_t pyins_core_align(void);
 size_t pyins_sizeof_config(void);
 size_t pyins_sizeof_sample(void);
 size_t pyins_sizeof_output(void);
+size_t pyins_sizeof_nav(void);
 
 /* Write the default configuration into *cfg (a zeroed struct means the same).
  * Returns PYINS_OK or PYINS_E_NULL. */
@@ -413,6 +437,16 @@ int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
                         size_t out_every, pyins_output *outputs, size_t out_capacity,
                         size_t *n_done, size_t *n_out);
 
+/* As pyins_run_decimated, with the compact record pyins_nav: a record
+ * after the steps whose tick reaches a multiple of out_every (1: after
+ * every step that advances the tick), the same rules for the capacity,
+ * gaps, rejected samples, *n_done and *n_out. The records are the
+ * corresponding fields of pyins_run_decimated's, bit for bit.
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_run_nav(pyins_core *core, const pyins_sample *samples, size_t n,
+                  size_t out_every, pyins_nav *navs, size_t out_capacity,
+                  size_t *n_done, size_t *n_out);
+
 /* Leave the indexing FAULT state: the cycle starts again at its first step
  * from the measured table angle (A_c, A_s kept). Does nothing otherwise.
  * Returns PYINS_OK or a negative pyins_status. */
@@ -436,6 +470,10 @@ int pyins_restore(void *mem, size_t mem_size, const void *buf, size_t buf_size);
 /* Write the current state as an output record (no step).
  * Returns PYINS_OK or a negative pyins_status. */
 int pyins_get_output(const pyins_core *core, pyins_output *out);
+
+/* Write the current state as a compact record (no step).
+ * Returns PYINS_OK or a negative pyins_status. */
+int pyins_get_nav(const pyins_core *core, pyins_nav *nav);
 
 /* Write the indexing motor's command after the last step (no record is
  * built: a closed loop that reads the command every tick and a record every

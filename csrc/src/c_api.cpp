@@ -17,6 +17,7 @@ using pyins::firmware::Firmware;
 
 static_assert(sizeof(pyins_sample) == 8 * sizeof(double), "pyins_sample layout");
 static_assert(sizeof(pyins_output) % 8 == 0, "pyins_output layout: arrays of records stay aligned");
+static_assert(sizeof(pyins_nav) == 160, "pyins_nav layout: arrays of records stay aligned");
 static_assert(alignof(Firmware) <= 16, "instance alignment");
 
 namespace {
@@ -69,6 +70,68 @@ uint32_t get_u32(const unsigned char* p) {
            (static_cast<uint32_t>(p[2]) << 16) | (static_cast<uint32_t>(p[3]) << 24);
 }
 
+/// pyins_run_decimated and pyins_run_nav: one loop, the record written by
+/// Firmware::output (outputs) or Firmware::nav_record (navs, when not
+/// null) at the multiples of out_every. One function, not one per record
+/// type: the Cortex-M7 text budget (docs/embedded.md) holds one copy.
+int run_every(pyins_core* core, const pyins_sample* samples, size_t n, size_t out_every,
+              pyins_output* outputs, pyins_nav* navs, size_t out_capacity, size_t* n_done, size_t* n_out) {
+    if (n_done != nullptr) {
+        *n_done = 0;
+    }
+    if (n_out != nullptr) {
+        *n_out = 0;
+    }
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if ((samples == nullptr && n > 0u) || (outputs == nullptr && navs == nullptr && out_capacity > 0u)) {
+        return PYINS_E_NULL;
+    }
+    if (out_every == 0u) {
+        return PYINS_E_BAD_ARG;
+    }
+    if (out_capacity < n / out_every + 1u) {
+        return PYINS_E_BUFFER_TOO_SMALL;
+    }
+    Firmware* fw = const_cast<Firmware*>(cfw);
+    const uint64_t every = static_cast<uint64_t>(out_every);
+    size_t written = 0;
+    // the next multiple of out_every after the current tick
+    uint64_t next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
+    for (size_t i = 0; i < n; ++i) {
+        if (written == out_capacity &&
+            static_cast<uint64_t>(fw->tick() + fw->ticks_for(samples[i])) >= next) {
+            // seq gaps passed more multiples than n / out_every + 1: stop
+            // before the step whose record has no room
+            return PYINS_E_BUFFER_TOO_SMALL;
+        }
+        const int s = fw->step(samples[i], nullptr);
+        if (s < 0) {
+            return s;
+        }
+        if (n_done != nullptr) {
+            *n_done = i + 1u;
+        }
+        // a multiple of out_every reached (or passed by a bridged gap)
+        if (static_cast<uint64_t>(fw->tick()) >= next) {
+            next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
+            if (navs != nullptr) {
+                fw->nav_record(&navs[written]);
+            } else {
+                fw->output(&outputs[written]);
+            }
+            written = written + 1u;
+            if (n_out != nullptr) {
+                *n_out = written;
+            }
+        }
+    }
+    return PYINS_OK;
+}
+
 }  // namespace
 
 extern "C" {
@@ -85,6 +148,7 @@ size_t pyins_core_align(void) { return alignof(Firmware); }
 size_t pyins_sizeof_config(void) { return sizeof(pyins_config); }
 size_t pyins_sizeof_sample(void) { return sizeof(pyins_sample); }
 size_t pyins_sizeof_output(void) { return sizeof(pyins_output); }
+size_t pyins_sizeof_nav(void) { return sizeof(pyins_nav); }
 
 int pyins_config_default(pyins_config* cfg) {
     if (cfg == nullptr) {
@@ -161,59 +225,16 @@ int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
     return PYINS_OK;
 }
 
+
 int pyins_run_decimated(pyins_core* core, const pyins_sample* samples, size_t n,
                         size_t out_every, pyins_output* outputs, size_t out_capacity,
                         size_t* n_done, size_t* n_out) {
-    if (n_done != nullptr) {
-        *n_done = 0;
-    }
-    if (n_out != nullptr) {
-        *n_out = 0;
-    }
-    const Firmware* cfw = nullptr;
-    const int status = checked(core, &cfw);
-    if (status != PYINS_OK) {
-        return status;
-    }
-    if ((samples == nullptr && n > 0u) || (outputs == nullptr && out_capacity > 0u)) {
-        return PYINS_E_NULL;
-    }
-    if (out_every == 0u) {
-        return PYINS_E_BAD_ARG;
-    }
-    if (out_capacity < n / out_every + 1u) {
-        return PYINS_E_BUFFER_TOO_SMALL;
-    }
-    Firmware* fw = const_cast<Firmware*>(cfw);
-    const uint64_t every = static_cast<uint64_t>(out_every);
-    size_t written = 0;
-    // the next multiple of out_every after the current tick
-    uint64_t next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
-    for (size_t i = 0; i < n; ++i) {
-        if (written == out_capacity &&
-            static_cast<uint64_t>(fw->tick() + fw->ticks_for(samples[i])) >= next) {
-            // seq gaps passed more multiples than n / out_every + 1: stop
-            // before the step whose record has no room
-            return PYINS_E_BUFFER_TOO_SMALL;
-        }
-        const int s = fw->step(samples[i], nullptr);
-        if (s < 0) {
-            return s;
-        }
-        if (n_done != nullptr) {
-            *n_done = i + 1u;
-        }
-        // a multiple of out_every reached (or passed by a bridged gap)
-        if (static_cast<uint64_t>(fw->tick()) >= next) {
-            next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
-            fw->output(&outputs[written]);
-            written = written + 1u;
-            if (n_out != nullptr) {
-                *n_out = written;
-            }
-        }
-    }
-    return PYINS_OK;
+    return run_every(core, samples, n, out_every, outputs, nullptr, out_capacity, n_done, n_out);
+}
+
+int pyins_run_nav(pyins_core* core, const pyins_sample* samples, size_t n, size_t out_every,
+                  pyins_nav* navs, size_t out_capacity, size_t* n_done, size_t* n_out) {
+    return run_every(core, samples, n, out_every, nullptr, navs, out_capacity, n_done, n_out);
 }
 
 int pyins_index_reset(pyins_core* core) {
@@ -298,6 +319,19 @@ int pyins_get_output(const pyins_core* core, pyins_output* out) {
         return PYINS_E_NULL;
     }
     fw->output(out);
+    return PYINS_OK;
+}
+
+int pyins_get_nav(const pyins_core* core, pyins_nav* nav) {
+    const Firmware* fw = nullptr;
+    const int status = checked(core, &fw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (nav == nullptr) {
+        return PYINS_E_NULL;
+    }
+    fw->nav_record(nav);
     return PYINS_OK;
 }
 

@@ -607,8 +607,10 @@ void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, d
     // are constant; on seed 000's bad sea state one missing tick leaves 0.19"
     // of attitude error against 20" (docs/core.md, "Sample-level faults").
     // Uniform motion is bridged bit-exactly (the difference is 0).
-    const Vec3 dtheta0 = last_dtheta_;
-    const Vec3 dv0 = last_dv_;
+    // (the last sample's increments are read in place: advance does not
+    // change them, and copies would add 48 bytes to the deepest stack path)
+    const Vec3& dtheta0 = last_dtheta_;
+    const Vec3& dv0 = last_dv_;
     const Vec3 ddtheta = dtheta_p - dtheta0;
     const Vec3 ddv = dv_p - dv0;
     const double enc0 = encoder_;
@@ -622,7 +624,7 @@ void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, d
     }
 }
 
-void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
+PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     // 1. Unwrap the encoder: the table turns far less than pi per tick.
     const double dalpha = wrap_pi(encoder - encoder_);
     table_angle_ = table_angle_ + dalpha;
@@ -762,26 +764,24 @@ void Firmware::motor_command(pyins_motor_command* cmd) const {
     cmd->index_fault = static_cast<int32_t>(idx_.fault);
 }
 
-void Firmware::output(pyins_output* out) const {
+void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
+                        double quat_nb[4], uint32_t* state_flags) const {
     const strapdown::NavState& nav = sd_.nav;
-    out->tick = tick_;
-    out->mode = static_cast<int32_t>(mode_);
-    out->fault_flags = faults_;
-    out->reserved0 = 0;
-    out->lat_rad = nav.lat;
-    out->lon_rad = nav.lon;
-    out->height_m = nav.height;
-    out->vel_n_mps[0] = nav.vel_n(0);
-    out->vel_n_mps[1] = nav.vel_n(1);
-    out->vel_n_mps[2] = nav.vel_n(2);
     if (has_lever_ != 0 && (mode_ == Mode::kFineAlign || mode_ == Mode::kNavigate)) {
         // The state is the accelerometers'; the record the reference point's.
         Vec3 vel;
-        reference_point(&out->lat_rad, &out->lon_rad, &out->height_m, &vel);
-        out->vel_n_mps[0] = vel(0);
-        out->vel_n_mps[1] = vel(1);
+        reference_point(lat, lon, height, &vel);
+        vel_n[0] = vel(0);
+        vel_n[1] = vel(1);
         // a held vertical channel holds the reference point too
-        out->vel_n_mps[2] = sd_.vertical == strapdown::Vertical::kHold ? 0.0 : vel(2);
+        vel_n[2] = sd_.vertical == strapdown::Vertical::kHold ? 0.0 : vel(2);
+    } else {
+        *lat = nav.lat;
+        *lon = nav.lon;
+        *height = nav.height;
+        vel_n[0] = nav.vel_n(0);
+        vel_n[1] = nav.vel_n(1);
+        vel_n[2] = nav.vel_n(2);
     }
 
     // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
@@ -806,17 +806,39 @@ void Firmware::output(pyins_output* out) const {
             valid = false;
         }
     }
-    out->state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
+    *state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
     const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(q_np, q_pb));
+    quat_np[0] = q_np.w;
+    quat_np[1] = q_np.x;
+    quat_np[2] = q_np.y;
+    quat_np[3] = q_np.z;
+    quat_nb[0] = q_nb.w;
+    quat_nb[1] = q_nb.x;
+    quat_nb[2] = q_nb.y;
+    quat_nb[3] = q_nb.z;
+}
+
+void Firmware::nav_record(pyins_nav* nav) const {
+    nav->tick = tick_;
+    nav->mode = static_cast<int32_t>(mode_);
+    nav->fault_flags = faults_;
+    nav->index_state = static_cast<int32_t>(idx_.state);
+    solution(&nav->lat_rad, &nav->lon_rad, &nav->height_m, nav->vel_n_mps, nav->quat_np, nav->quat_nb,
+             &nav->state_flags);
+    nav->table_angle_rad = table_angle_;
+    nav->motor_rate_cmd_rad_s = idx_.cmd_rate;
+    nav->table_angle_cmd_rad = idx_.cmd_angle;
+}
+
+void Firmware::output(pyins_output* out) const {
+    out->tick = tick_;
+    out->mode = static_cast<int32_t>(mode_);
+    out->fault_flags = faults_;
+    out->reserved0 = 0;
+    solution(&out->lat_rad, &out->lon_rad, &out->height_m, out->vel_n_mps, out->quat_np, out->quat_nb,
+             &out->state_flags);
+    const Quat q_nb{out->quat_nb[0], out->quat_nb[1], out->quat_nb[2], out->quat_nb[3]};
     const Vec3 euler_b = attitude::quat_to_euler(q_nb);
-    out->quat_nb[0] = q_nb.w;
-    out->quat_nb[1] = q_nb.x;
-    out->quat_nb[2] = q_nb.y;
-    out->quat_nb[3] = q_nb.z;
-    out->quat_np[0] = q_np.w;
-    out->quat_np[1] = q_np.x;
-    out->quat_np[2] = q_np.y;
-    out->quat_np[3] = q_np.z;
     out->euler_b_rad[0] = euler_b(0);
     out->euler_b_rad[1] = euler_b(1);
     out->euler_b_rad[2] = euler_b(2);

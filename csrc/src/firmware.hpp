@@ -73,6 +73,9 @@ class Firmware {
 
     /// The current state as an output record.
     void output(pyins_output* out) const;
+    /// The current state as a compact record: output()'s fields of the
+    /// same names, bit for bit (both are written from solution()).
+    void nav_record(pyins_nav* nav) const;
     /// The motor command fields of output(), alone (pyins_get_motor_command).
     void motor_command(pyins_motor_command* cmd) const;
 
@@ -85,6 +88,13 @@ class Firmware {
     int64_t tick() const { return tick_; }
 
   private:
+    /// What output() and nav_record() both report, written into the
+    /// record's own fields (no copy in between): the reference point's
+    /// position and velocity, the IMU's and the ship's attitude
+    /// quaternions [w, x, y, z], and whether the attitude is a solution
+    /// (the record's state_flags).
+    void solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
+                  double quat_nb[4], uint32_t* state_flags) const;
     /// Classify a sample's seq against the last one taken.
     SeqStep seq_step(uint32_t seq) const;
     /// Finite and within the saturation limits.

@@ -16,8 +16,10 @@
 /// changes no operation, so the bits are the same either way.
 #if defined(__ARM_ARCH) || !defined(__GNUC__)
 #define PYINS_HOT_FLATTEN
+#define PYINS_HOT_INLINE
 #else
 #define PYINS_HOT_FLATTEN [[gnu::flatten]]
+#define PYINS_HOT_INLINE [[gnu::always_inline]] inline
 #endif
 
 namespace pyins {

@@ -3,12 +3,13 @@
 Mirrors ``csrc/src/c_api.cpp``: ``pyins_init`` (check everything, then
 build the instance), ``pyins_step``, ``pyins_run`` (stop at the first
 rejected sample), ``pyins_run_decimated`` (one record each time the tick
-reaches a multiple of ``every``), ``pyins_get_output`` and
+reaches a multiple of ``every``), ``pyins_run_nav`` (the same with the
+compact record), ``pyins_get_output``, ``pyins_get_nav`` and
 ``pyins_index_reset``, over :class:`pyins.reference.firmware.Firmware`.
 
 :class:`Firmware` is the reference engine: the contract of
 ``pyins.native.Firmware`` (the same constructor, ``step``, ``run``,
-``output``, ``index_reset``, ``snapshot``/``restore``, ``last_status`` and
+``run_nav``, ``nav``, ``output``, ``index_reset``, ``snapshot``/``restore``, ``last_status`` and
 ``config``), the same exceptions (``native.ConfigError``,
 ``native.SampleError``, ``native.SnapshotError``, ``native.CoreError``) and
 records of ``native.OUTPUT_DTYPE``, so that a caller swaps
@@ -83,9 +84,11 @@ def pyins_run(fw, samples, outputs):
     return abi.PYINS_OK, samples.shape[0]
 
 
-def pyins_run_decimated(fw, samples, every):
+def pyins_run_decimated(fw, samples, every, record=None):
     """(status, n_done, records): a record each time the tick reaches (or a
-    bridged gap passes) the next multiple of ``every``."""
+    bridged gap passes) the next multiple of ``every``; ``record`` writes it
+    (the firmware's output, or nav_record for pyins_run_nav)."""
+    record = fw.output if record is None else record
     if every < 1:
         return abi.PYINS_E_BAD_ARG, 0, []
     records = []
@@ -97,12 +100,22 @@ def pyins_run_decimated(fw, samples, every):
             return status, i, records
         if fw.tick >= nxt:
             nxt = (fw.tick // every + 1) * every
-            records.append(fw.output())
+            records.append(record())
     return abi.PYINS_OK, samples.shape[0], records
+
+
+def pyins_run_nav(fw, samples, every):
+    """pyins_run_decimated with the compact record."""
+    return pyins_run_decimated(fw, samples, every, record=fw.nav_record)
 
 
 def pyins_get_output(fw, record):
     fill(record, fw.output())
+    return abi.PYINS_OK
+
+
+def pyins_get_nav(fw, record):
+    fill(record, fw.nav_record())
     return abi.PYINS_OK
 
 
@@ -191,6 +204,26 @@ class Firmware:
         if status != abi.PYINS_OK:
             raise native.SampleError(status, n_done, outputs[:n_done].copy())
         return outputs
+
+    def run_nav(self, samples, every=1):
+        """As ``run`` with the compact record (see ``native.Firmware.run_nav``)."""
+        samples = _check_samples(samples)
+        every = int(every)
+        if every < 1:
+            raise ValueError(f"every: must be a positive number of ticks, got {every}")
+        status, n_done, records = pyins_run_nav(self._fw, samples, every)
+        out = np.zeros(len(records), dtype=native.NAV_DTYPE)
+        for rec, o in zip(out, records):
+            fill(rec, o)
+        if status != abi.PYINS_OK:
+            raise native.SampleError(status, n_done, out)
+        return out
+
+    def nav(self):
+        """The current state as one NAV_DTYPE record."""
+        out = np.zeros(1, dtype=native.NAV_DTYPE)
+        pyins_get_nav(self._fw, out[0])
+        return out[0].copy()
 
     def index_reset(self):
         """Leave the indexing FAULT state (pyins_index_reset)."""

@@ -548,8 +548,15 @@ class Firmware:
         # 6. The tick.
         self.tick = self.tick + 1
 
-    def output(self):
+    def solution(self):
+        """(lat, lon, height, vel, q_np, q_nb, state_flags): what output()
+        and nav_record() both report."""
         nav = self.sd.nav
+        lat, lon, height, vel = nav.lat, nav.lon, nav.height, nav.vel_n.copy()
+        if self.has_lever and self.mode in (abi.PYINS_MODE_FINE_ALIGN, abi.PYINS_MODE_NAVIGATE):
+            lat, lon, height, vel = self.reference_point()
+            if self.sd.vertical == strapdown.VERTICAL_HOLD:
+                vel[2] = 0.0
         q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
         q_np = nav.quat_np
         valid = self.att_valid
@@ -562,24 +569,43 @@ class Firmware:
             if ((self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0)
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
+        state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
         q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
-        euler_b = attitude.quat_to_euler(q_nb)
-        lat, lon, height, vel = nav.lat, nav.lon, nav.height, nav.vel_n.copy()
-        if self.has_lever and self.mode in (abi.PYINS_MODE_FINE_ALIGN, abi.PYINS_MODE_NAVIGATE):
-            lat, lon, height, vel = self.reference_point()
-            if self.sd.vertical == strapdown.VERTICAL_HOLD:
-                vel[2] = 0.0
+        return lat, lon, height, vel, q_np.copy(), q_nb, state_flags
+
+    def nav_record(self):
+        lat, lon, height, vel, q_np, q_nb, state_flags = self.solution()
         return {
             "tick": self.tick,
             "mode": self.mode,
             "fault_flags": self.faults,
-            "state_flags": abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0,
+            "state_flags": state_flags,
+            "index_state": self.idx.state,
             "lat_rad": lat,
             "lon_rad": lon,
             "height_m": height,
             "vel_n_mps": vel,
             "quat_nb": q_nb,
-            "quat_np": q_np.copy(),
+            "quat_np": q_np,
+            "table_angle_rad": self.table_angle,
+            "motor_rate_cmd_rad_s": self.idx.cmd_rate,
+            "table_angle_cmd_rad": self.idx.cmd_angle,
+        }
+
+    def output(self):
+        lat, lon, height, vel, q_np, q_nb, state_flags = self.solution()
+        euler_b = attitude.quat_to_euler(q_nb)
+        return {
+            "tick": self.tick,
+            "mode": self.mode,
+            "fault_flags": self.faults,
+            "state_flags": state_flags,
+            "lat_rad": lat,
+            "lon_rad": lon,
+            "height_m": height,
+            "vel_n_mps": vel,
+            "quat_nb": q_nb,
+            "quat_np": q_np,
             "euler_b_rad": euler_b,
             "heading_b_rad": attitude.yaw_to_heading(euler_b[2]),
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),

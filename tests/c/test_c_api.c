@@ -428,6 +428,42 @@ int main(void) {
             }
             check(same, "decimated records equal the full run's at ticks 7, 14, ...");
         }
+
+        /* Compact records (pyins_run_nav): the same ticks as the decimated
+         * run, each field the full record's, bit for bit. */
+        {
+            static pyins_nav v[N / 7 + 2];
+            pyins_nav last;
+            size_t nd = 0, no = 0, c;
+            int same = 1;
+            check_status(pyins_init(mem2, size, &cfg), PYINS_OK, "init C (compact)");
+            check_status(pyins_run_nav((pyins_core *)mem2, samples, 10, 0, v, 10, &nd, &no),
+                         PYINS_E_BAD_ARG, "run_nav out_every 0");
+            check_status(pyins_run_nav((pyins_core *)mem2, samples, 100, 7, v, 14, &nd, &no),
+                         PYINS_E_BUFFER_TOO_SMALL, "run_nav capacity too small");
+            check(nd == 0 && no == 0, "refused run_nav stepped nothing");
+            check_status(pyins_run_nav((pyins_core *)mem2, samples, 5, 7, NULL, 14, &nd, &no),
+                         PYINS_E_NULL, "run_nav NULL records");
+            check_status(pyins_get_nav((const pyins_core *)mem2, NULL), PYINS_E_NULL, "get_nav NULL");
+            check_status(pyins_get_nav(NULL, &last), PYINS_E_NULL, "get_nav NULL core");
+            check_status(pyins_run_nav((pyins_core *)mem2, samples, N, 7, v, N / 7 + 2, &nd, &no),
+                         PYINS_OK, "run_nav");
+            check(nd == N && no == N / 7, "compact record count");
+            for (c = 0; c < no; ++c) {
+                const pyins_output *o = &a[7 * (c + 1) - 1];
+                if (v[c].tick != o->tick || v[c].mode != o->mode || v[c].fault_flags != o->fault_flags ||
+                    v[c].state_flags != o->state_flags || v[c].index_state != o->index_state ||
+                    memcmp(&v[c].lat_rad, &o->lat_rad, 6 * sizeof(double)) != 0 ||
+                    memcmp(v[c].quat_nb, o->quat_nb, 8 * sizeof(double)) != 0 ||
+                    memcmp(&v[c].table_angle_rad, &o->table_angle_rad, sizeof(double)) != 0 ||
+                    memcmp(&v[c].motor_rate_cmd_rad_s, &o->motor_rate_cmd_rad_s, 2 * sizeof(double)) != 0) {
+                    same = 0;
+                }
+            }
+            check(same, "compact records are the full records' fields");
+            check_status(pyins_get_nav((const pyins_core *)mem2, &last), PYINS_OK, "get_nav");
+            check(last.tick == (int64_t)N, "get_nav: the state after the run");
+        }
         free(raw2);
     }
 

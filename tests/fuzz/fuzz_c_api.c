@@ -502,6 +502,18 @@ static void get_a(fuzz *f, pyins_output *o) {
             memcmp(&cmd.angle_rad, &o->table_angle_cmd_rad, sizeof(double)) == 0 &&
             cmd.index_state == o->index_state && cmd.index_fault == o->index_fault,
             "motor command == the record's fields");
+    /* and so is the compact record (pyins_get_nav) */
+    {
+        pyins_nav v;
+        REQUIRE_EQ(pyins_get_nav((const pyins_core *)f->a, &v), PYINS_OK, "get_nav");
+        REQUIRE(v.tick == o->tick && v.mode == o->mode && v.fault_flags == o->fault_flags &&
+                    v.state_flags == o->state_flags && v.index_state == o->index_state &&
+                    memcmp(&v.lat_rad, &o->lat_rad, 6 * sizeof(double)) == 0 &&
+                    memcmp(v.quat_nb, o->quat_nb, 8 * sizeof(double)) == 0 &&
+                    memcmp(&v.table_angle_rad, &o->table_angle_rad, sizeof(double)) == 0 &&
+                    memcmp(&v.motor_rate_cmd_rad_s, &o->motor_rate_cmd_rad_s, 2 * sizeof(double)) == 0,
+                "compact record == the record's fields");
+    }
 }
 
 /* After a call that may have stepped: sticky fault bits, output ranges. */

@@ -21,6 +21,8 @@ def test_layout_matches_library():
     assert native.SAMPLE_DTYPE.fields["seq"][1] == 56
     assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 432   # + coarse_vrw, fine_vrw (ABI 0.10)
     assert native.OUTPUT_DTYPE.itemsize % 8 == 0
+    assert native.NAV_DTYPE.itemsize == native.lib.pyins_sizeof_nav() == 160   # the compact record (ABI 0.12)
+    assert set(native.NAV_DTYPE.names) < set(native.OUTPUT_DTYPE.names)
     assert native.abi_version() == native.EXPECTED_ABI
     assert native.version() == "0.1.0"
 

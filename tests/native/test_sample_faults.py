@@ -303,6 +303,21 @@ def test_decimated_records_with_gaps_past_multiples():
     assert np.concatenate(parts).tobytes() == full[24::25].tobytes()
 
 
+def test_compact_records_with_gaps_past_multiples():
+    """pyins_run_nav keeps pyins_run_decimated's rules: the same ticks, the
+    same fields, across gaps that pass more multiples than the buffer holds."""
+    s = static(400)
+    cfg = dict(SEQ, seq_max_gap_ticks=100)
+    sparse = s[::40].copy()
+    full = native.Firmware(cfg).run(sparse, every=10)
+    compact = native.Firmware(cfg).run_nav(sparse, every=10)
+    assert list(compact["tick"]) == list(full["tick"])
+    for field in native.NAV_DTYPE.names:
+        assert np.ascontiguousarray(compact[field]).tobytes() == np.ascontiguousarray(full[field]).tobytes()
+    with pytest.raises(ValueError, match="every: must be a positive"):
+        native.Firmware(cfg).run_nav(s, every=0)
+
+
 def test_snapshot_carries_the_sequence_state():
     """A snapshot taken before a gap, restored, bridges it exactly as the
     uninterrupted instance does (seq, last increments and counters are in it)."""

@@ -107,3 +107,32 @@ def run(cfg, dtheta, dv, seq):
         out[k] = np.frombuffer(ffi.buffer(rec), dtype=native.OUTPUT_DTYPE)[0]
         enc = float(rec.table_angle_cmd_rad) % two_pi
     return out
+
+
+def run_compact(cfg, dtheta, dv, seq):
+    """As run(), through pyins_run_nav one sample at a time (out_every 1):
+    every tick's compact record (NAV_DTYPE). A sample that adds no tick (a
+    dropped duplicate) or is rejected writes none: pyins_get_nav then gives
+    the state, as pyins_step's record would."""
+    ffi, lib = native.ffi, native.lib
+    fw = native.Firmware(cfg)
+    out = np.zeros(len(dtheta), dtype=native.NAV_DTYPE)
+    nav = ffi.new("pyins_nav[2]")
+    sample = ffi.new("pyins_sample *")
+    n_done = ffi.new("size_t *")
+    n_out = ffi.new("size_t *")
+    enc = float(cfg.get("table_angle_rad", 0.0))
+    two_pi = 2.0 * np.pi
+    for k in range(len(dtheta)):
+        for i in range(3):
+            sample.dtheta_p_rad[i] = dtheta[k, i]
+            sample.dv_p_mps[i] = dv[k, i]
+        sample.table_angle_rad = enc
+        sample.seq = int(seq[k]) & 0xFFFFFFFF
+        lib.pyins_run_nav(fw.core, sample, 1, 1, nav, 2, n_done, n_out)
+        if n_out[0] == 0:
+            assert lib.pyins_get_nav(fw.core, nav) == 0
+        out[k] = np.frombuffer(ffi.buffer(nav, native.NAV_DTYPE.itemsize), dtype=native.NAV_DTYPE)[0]
+        enc = float(nav[0].table_angle_cmd_rad) % two_pi
+    return out
+

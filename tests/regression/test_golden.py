@@ -43,6 +43,24 @@ def test_golden_records(name):
         pytest.fail(f"{name}: the firmware's bits moved: {_first_difference(got, want)}")
 
 
+@pytest.mark.parametrize("name", sorted(cases.CASES))
+def test_compact_records_are_the_full_records_fields(name):
+    """pyins_run_nav's record is pyins_output's fields of the same names,
+    bit for bit, on every tick of every case: each mode, scheme, lever arm
+    and sample fault (issue 15: the compact record must not be a second
+    navigation solution)."""
+    d = np.load(os.path.join(DATA, f"{name}.npz"))
+    cfg = json.loads(str(d["config"]))
+    full = cases.run(cfg, d["dtheta"], d["dv"], d["seq"])
+    compact = cases.run_compact(cfg, d["dtheta"], d["dv"], d["seq"])
+    for field in native.NAV_DTYPE.names:
+        got = np.ascontiguousarray(compact[field])
+        want = np.ascontiguousarray(full[field])
+        if got.tobytes() != want.tobytes():
+            k = next(i for i in range(len(got)) if got[i].tobytes() != want[i].tobytes())
+            pytest.fail(f"{name}: tick record {k}: field {field}: compact {got[k]!r}, full {want[k]!r}")
+
+
 def test_every_mode_and_scheme_is_covered():
     # the suite must reach every mode, every preset scheme and the custom one,
     # both coarse methods and all three fine filters
