@@ -2,25 +2,39 @@
 """Reproduce seed 000 (inertial-frame coarse alignment) with the C++ firmware.
 The set-up is the built-in campaigns seed000_static and seed000_swing (their
 headings, seed formulas and base scenarios, pyins/campaigns/ and
-pyins/scenarios/); this driver adds the theoretical limits, tables and curves.
+pyins/scenarios/); this driver varies it by overrides and adds the
+theoretical limits, tables and curves.
 
     .venv/bin/python tools/papers/reproduce_seed000.py [--out runs/seed000] [--seeds 5]
+        [--ratio-seeds 30] [--methods triad[,eq8]]
 
-Writes into --out:
+Writes into --out (docs/results/seed000.md reads them):
 - table1_static.csv / .md: 6 headings x N noise seeds, pitch/roll/heading
-  errors at 150 s and the std per heading (the layout of the paper's Table 1),
-  against the truth and against the theoretical limit;
+  errors at 150 s and the std per heading (the layout of the paper's Table 1)
+  beside the paper's printed stds, against the truth and against the
+  theoretical limit; and what sets our heading std (30 seeds per heading,
+  gyro noise alone, accelerometer noise alone);
 - swing.csv / .md: 3 sea states x 6 headings x N seeds, errors at 200 s;
-- fig1_gyro_bias.png, fig1_accel_bias.png, fig2_ratio.png: convergence curves
-  like the paper's Figs. 1 and 2;
+- ratio.md, fig2_ratio.png: the paper's Fig. 2, r = t_k1 / t_k2 = 1/4, 1/2,
+  3/4, for each coarse method of --methods, --ratio-seeds noise seeds at
+  heading 0: RMS over the seeds of the heading error against the limit at
+  100, 150 and 200 s (and the noise-free value);
+- fig1_gyro_bias.png, fig1_accel_bias.png, fig1.md: the paper's Fig. 1 as it
+  plots it, the heading error against the truth over time for drifts 0.01,
+  0.03, 0.05 deg/h and biases 0.1, 0.3, 0.5 mg, with each one's limit;
 - seed000.json: every headline figure (units in the keys).
 
-Sensors: seed 000 gives bias levels only (0.01 deg/h, 0.1 mg). Noise is
-needed for "noise seeds": we use the levels seeds 002 and 003 give for the
-same class of marine RLG IMU (ARW 0.0005 deg/sqrt(h), VRW 5 ug/sqrt(Hz)).
-In 150 s an ARW of 0.0005 deg/sqrt(h) alone leaves a heading noise of
-about 0.7' (sigma of the equivalent east drift, ARW / sqrt(T), divided by
-W cos L), so the heading std is noise-limited near the paper's 1'.
+--methods: the coarse methods to compare in the ratio study, by their
+scenario names (firmware.coarse_method; pyins.scenario.COARSE_METHODS).
+The core implements TRIAD in place of the paper's eq. 8 (docs/papers.md,
+seed 000 §1); a method for eq. 8 as printed is named here when the core
+offers it, and the driver refuses a name the core does not offer.
+
+Sensors: seed 000 gives bias levels only (0.01 deg/h, 0.1 mg; the smallest
+of its Fig. 1) and no noise. Noise is needed for "noise seeds": the
+scenarios borrow the levels seeds 002 and 003 give for the same class of
+marine RLG IMU (ARW 0.0005 deg/sqrt(h), VRW 5 ug/sqrt(Hz)). That ARW, not
+the paper, sets our heading scatter (docs/results/seed000.md measures it).
 The paper's errors are against its own fine alignment, which carries the
 same unobservable part as the theoretical limit: compare our "vs limit"
 columns with its Table 1.
@@ -37,7 +51,7 @@ from pyins.reference.config import DEFAULT_COARSE_FIRST_S
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import ARCSEC_TO_RAD as ARCSEC
 from pyins.units import DEG_TO_RAD as DEG
-from pyins.units import TICK_HZ, TWO_PI, split_quantity
+from pyins.units import TICK_HZ, TWO_PI, UG_TO_MPS2, split_quantity
 
 #: the built-in campaigns (and their base scenarios) holding the set-up: Table 1's static
 #: alignments, the swinging base's, their headings and noise seeds
@@ -50,6 +64,17 @@ HEADINGS = tuple(int(split_quantity(h)[0])
 #: the convergence curves (Figs. 1 and 2): 250 s at heading 0, one noise seed
 CURVES = {"duration": "250 s", "firmware.coarse_time": "250 s"}
 CURVES_HEADING, CURVES_SEED = 0, 5
+#: Fig. 2's ratios and the instants the ratio study reads (one 200-s run gives them all: the
+#: solution at t is that of an alignment of length t, the grid holding t_k1 = r t)
+RATIOS = ((0.25, "1/4"), (0.5, "1/2"), (0.75, "3/4"))
+RATIO_TIMES = (100, 150, 200)
+#: Fig. 1's drifts [deg/h] and biases [ug]
+FIG1_GYRO_DPH, FIG1_ACCEL_UG = (0.01, 0.03, 0.05), (100.0, 300.0, 500.0)
+#: the paper's Table 1 std per heading [arcsec] (pitch, roll, heading) as printed; its
+#: recomputed stds differ at 240 deg heading (21.53) and 300 deg pitch (0.576): docs/papers.md
+PAPER_TABLE1_STD = {0: (0.471, 0.489, 22.864), 60: (0.813, 0.597, 29.900),
+                    120: (0.913, 0.506, 35.759), 180: (0.224, 0.270, 14.630),
+                    240: (0.824, 0.634, 24.455), 300: (0.544, 0.796, 52.157)}
 
 
 def sensors(gyro_dph=None, accel_ug=None, seed=0, noise=True):
@@ -82,13 +107,14 @@ def motion(state, heading):
     return run_spec(state, heading, 0).motion
 
 
-def campaign_specs(name, n_seeds):
+def campaign_specs(name, n_seeds, overrides=None):
     """[(grid values, run, RunSpec)] of built-in campaign ``name`` with ``n_seeds`` noise
-    seeds per grid point (its seed formula), in its order (grid, then seeds)."""
+    seeds per grid point (its seed formula), in its order (grid, then seeds), and
+    ``overrides`` on every run."""
     camp = campaign.load_campaign(name)
     camp = campaign.from_args(camp.base, camp.grid, seeds=n_seeds, group_by=camp.group_by,
-                              overrides=camp.overrides, seed_formula=camp.seed_formula,
-                              compare=camp.compare)
+                              overrides={**camp.overrides, **(overrides or {})},
+                              seed_formula=camp.seed_formula, compare=camp.compare)
     out = []
     for point in camp.points:
         (spec,) = camp.base.with_overrides(point.overrides).runs()
@@ -105,10 +131,11 @@ def navigate(spec):
 
 
 def euler_errors(res, k=-1):
-    """pitch, roll, heading errors [arcsec] of record k (heading = marine)."""
+    """pitch, roll, heading errors [arcsec] of record(s) k (heading = marine): (3,) for one
+    record, (n, 3) for a slice or an index array."""
     d = res.outputs["euler_b_rad"][k] - res.truth.euler[k]
     d = (d + np.pi) % TWO_PI - np.pi
-    return np.array([d[0], d[1], -d[2]]) / ARCSEC
+    return np.stack([d[..., 0], d[..., 1], -d[..., 2]], axis=-1) / ARCSEC
 
 
 def limit_euler(m, errors, t):
@@ -127,36 +154,96 @@ def limit_euler(m, errors, t):
     return np.array([d_pitch, d_roll, -d_yaw]) / ARCSEC
 
 
-def table_static(out, n_seeds, fig):
+def static_rows(n_seeds, overrides=None):
+    """Table 1's alignments (seed000_static at the six headings, its seeds, ``overrides``):
+    array of [heading, run, pitch, roll, heading errors, the same against the limit] [arcsec]
+    at 150 s."""
     rows = []
-    for values, run, spec in campaign_specs(STATIC, n_seeds):
+    for values, run, spec in campaign_specs(STATIC, n_seeds, overrides):
         h = int(split_quantity(values["motion.heading"])[0])
         res, _ = navigate(spec)
         err = euler_errors(res)
         lim = limit_euler(spec.motion, spec.errors, spec.duration_ticks / TICK_HZ)
         rows.append([h, run, *err, *(err - lim)])
-    a = np.array(rows)
+    return np.array(rows)
+
+
+def std_per_heading(a):
+    """(6, 3) sample std (n - 1, as the paper's Table 1) over the runs of each heading of the
+    pitch, roll, heading errors against the limit [arcsec]."""
+    return np.array([a[a[:, 0] == h][:, 5:8].std(axis=0, ddof=1) for h in HEADINGS])
+
+
+def pooled(sd):
+    """RMS over the headings of per-heading stds."""
+    return float(np.sqrt(np.mean(np.asarray(sd) ** 2)))
+
+
+def table_static(out, n_seeds, fig, noise_seeds=30):
+    a = static_rows(n_seeds)
     with open(os.path.join(out, "table1_static.csv"), "w") as f:
         f.write("heading_deg,seed,pitch_err_arcsec,roll_err_arcsec,heading_err_arcsec,"
                 "pitch_vs_limit_arcsec,roll_vs_limit_arcsec,heading_vs_limit_arcsec\n")
         for r in a:
             f.write(",".join(f"{v:.6g}" for v in r) + "\n")
-    md = ["| heading | pitch err (\") | roll err (\") | heading err (\") | std pitch vs limit | std roll vs limit | std heading vs limit |",
-          "|---|---|---|---|---|---|---|"]
-    stds = []
-    for h in HEADINGS:
+    stds = std_per_heading(a)
+    # what sets the heading std: the same alignments with noise_seeds runs per heading, with
+    # all the noise, with the gyro noise alone and with the accelerometer noise alone
+    split = {"all noise": {}, "gyro ARW only": {"sensors.accel_vrw": 0},
+             "accelerometer VRW only": {"sensors.gyro_arw": 0}}
+    sd_split = {k: std_per_heading(static_rows(noise_seeds, o)) for k, o in split.items()}
+    md = [f"| heading | std pitch (\") ours / paper | std roll (\") ours / paper | "
+          f"std heading (\") ours / paper | std heading (\"), {noise_seeds} seeds: "
+          + " / ".join(split) + " | mean heading err vs truth (\") |",
+          "|---|---|---|---|---|---|"]
+    for i, h in enumerate(HEADINGS):
         g = a[a[:, 0] == h]
-        sd = g[:, 5:8].std(axis=0, ddof=1)
-        stds.append(sd)
-        md.append(f"| {h} | {g[:, 2].mean():.3f} | {g[:, 3].mean():.3f} | {g[:, 4].mean():.2f} | "
-                  f"{sd[0]:.3f} | {sd[1]:.3f} | {sd[2]:.2f} |")
-    stds = np.array(stds)
+        pp = PAPER_TABLE1_STD[h]
+        md.append(f"| {h} | {stds[i, 0]:.3f} / {pp[0]:.3f} | {stds[i, 1]:.3f} / {pp[1]:.3f} | "
+                  f"{stds[i, 2]:.1f} / {pp[2]:.1f} | "
+                  + " / ".join(f"{sd_split[k][i, 2]:.1f}" for k in split)
+                  + f" | {g[:, 4].mean():.1f} |")
+    paper_pooled = pooled([v[2] for v in PAPER_TABLE1_STD.values()])
+    md.append(f"| pooled (RMS) | {pooled(stds[:, 0]):.3f} / "
+              f"{pooled([v[0] for v in PAPER_TABLE1_STD.values()]):.3f} | {pooled(stds[:, 1]):.3f} / "
+              f"{pooled([v[1] for v in PAPER_TABLE1_STD.values()]):.3f} | {pooled(stds[:, 2]):.1f} / "
+              f"{paper_pooled:.1f} | " + " / ".join(f"{pooled(sd_split[k][:, 2]):.1f}" for k in split)
+              + " | |")
+    md.append("| pooled level std (\"), pitch / roll, " + f"{noise_seeds} seeds: "
+              + "; ".join(f"{k} {pooled(sd_split[k][:, 0]):.3f} / {pooled(sd_split[k][:, 1]):.3f}"
+                          for k in split) + " | | | | | |")
     md.append("")
-    md.append("Errors are means over the seeds (against the truth); std columns are the std over "
-              "the seeds of the error against the theoretical limit (the paper's Table 1 std: "
-              "pitch/roll < 1\", heading < 1' = 60\").")
+    md.append(f"Std over the {n_seeds} runs of a heading (n - 1) of the error against the "
+              "theoretical limit at 150 s, beside the paper's Table 1 std (against its own fine "
+              "alignment; printed values). The paper's bound: pitch/roll < 1\", heading < 1' = 60\".")
+    # the noise that gives the paper's pooled heading std: the heading error is linear in the
+    # two noises, so scaling both by k scales the std by k
+    errs = sensors()[1]
+    scale = paper_pooled / pooled(sd_split["all noise"][:, 2])
+    arw_dpsh = scale * errs.gyro_arw / DEG * 60.0                 # rad/sqrt(s) -> deg/sqrt(h)
+    vrw_ug = scale * errs.accel_vrw / UG_TO_MPS2                 # (m/s)/sqrt(s) -> ug/sqrt(Hz)
+    check = pooled(std_per_heading(static_rows(noise_seeds, {
+        "sensors.gyro_arw": f"{float(arw_dpsh)!r} deg/sqrt(h)",
+        "sensors.accel_vrw": f"{float(vrw_ug)!r} ug/sqrt(Hz)"}))[:, 2])
+    md.append(f"The paper's pooled heading std {paper_pooled:.1f}\" is {scale:.2f} x ours over "
+              f"{noise_seeds} seeds: both noises scaled by {scale:.2f} (ARW {arw_dpsh:.5f} deg/sqrt(h), "
+              f"VRW {vrw_ug:.2f} ug/sqrt(Hz)) give a pooled {check:.1f}\" ({noise_seeds} seeds per "
+              "heading).")
     with open(os.path.join(out, "table1_static.md"), "w") as f:
         f.write("\n".join(md) + "\n")
+    fig["static_std_per_heading_arcsec"] = {str(h): stds[i].tolist() for i, h in enumerate(HEADINGS)}
+    fig["static_headings_heading_std_above_60arcsec"] = [h for i, h in enumerate(HEADINGS) if stds[i, 2] > 60.0]
+    fig["static_pooled_heading_std_arcsec"] = pooled(stds[:, 2])
+    fig["paper_pooled_heading_std_arcsec"] = paper_pooled
+    for k in split:
+        fig[f"static_{noise_seeds}seeds_pooled_heading_std_{k.replace(' ', '_')}_arcsec"] = \
+            pooled(sd_split[k][:, 2])
+        fig[f"static_{noise_seeds}seeds_heading_std_{k.replace(' ', '_')}_arcsec"] = sd_split[k][:, 2].tolist()
+        fig[f"static_{noise_seeds}seeds_pooled_pitch_roll_std_{k.replace(' ', '_')}_arcsec"] = [
+            pooled(sd_split[k][:, 0]), pooled(sd_split[k][:, 1])]
+    fig["static_paper_noise_scale"] = float(scale)
+    fig["static_paper_noise_scaled_arw_dpsh_vrw_ugphz"] = [float(arw_dpsh), float(vrw_ug)]
+    fig["static_paper_noise_scaled_pooled_heading_std_arcsec"] = check
     fig["static_max_std_level_arcsec"] = float(stds[:, :2].max())
     fig["static_max_std_heading_arcsec"] = float(stds[:, 2].max())
     fig["static_max_abs_level_vs_limit_arcsec"] = float(np.abs(a[:, 5:7]).max())
@@ -193,61 +280,182 @@ def table_swing(out, n_seeds, fig):
     return "\n".join(md)
 
 
-def curves(out, fig):
+def check_methods(text):
+    """The coarse methods named in --methods ("triad", "triad,eq8", ...), each one the core
+    offers (pyins.scenario.COARSE_METHODS, the values of firmware.coarse_method); exits
+    with a message naming what it offers otherwise."""
+    names = [m.strip() for m in text.split(",") if m.strip()]
+    offered = tuple(scenario.COARSE_METHODS)
+    for m in names:
+        if m not in offered:
+            hint = ""
+            if m == "eq8":
+                hint = (" The core solves C_ib0^i by TRIAD in place of seed 000's eq. 8 "
+                        "(docs/papers.md, seed 000 §1); eq. 8 as printed is not offered yet.")
+            raise SystemExit(f"reproduce_seed000: coarse method {m!r} is not offered by this core "
+                             f"(firmware.coarse_method: {', '.join(offered)}).{hint}")
+    if not names:
+        raise SystemExit("reproduce_seed000: --methods names no coarse method")
+    return names
+
+
+def heading_series(overrides, seeds, noise=True, vs_limit=True):
+    """(times [s], (len(seeds), records) heading error [arcmin]) of 250-s static alignments at
+    heading 0 (CURVES; the solution at t is that of an alignment of length t) with
+    ``overrides``, from the first coarse output on; against the theoretical limit
+    (``vs_limit``) or against the truth; without sensor noise when ``noise`` is False."""
+    o = dict(CURVES, **overrides)
+    if not noise:
+        o.update({"sensors.gyro_arw": 0, "sensors.accel_vrw": 0})
+    rows = []
+    for seed in seeds:
+        spec = run_spec("static", CURVES_HEADING, seed, o)
+        res, e = navigate(spec)
+        # every record after the first coarse output holds a solution; they are all
+        # provisional (ATT_VALID unset) while the coarse phase runs
+        k = np.nonzero(e.time_s > DEFAULT_COARSE_FIRST_S)[0]
+        h = euler_errors(res, k)[:, 2]
+        if vs_limit:
+            h = h - limit_euler(spec.motion, spec.errors, 0.0)[2]   # static: the same at every t
+        rows.append(h / 60.0)
+    return e.time_s[k], np.array(rows)
+
+
+def at(times, t):
+    return int(np.nonzero(times == float(t))[0][0])
+
+
+def rms(x, axis=0):
+    return np.sqrt(np.mean(np.square(x), axis=axis))
+
+
+def ratio_study(out, n_seeds, methods, fig):
+    """The paper's Fig. 2: r = 1/4, 1/2, 3/4, heading RMS against the limit over the seeds."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    panels = [
-        ("fig1_gyro_bias.png", "gyro bias",
-         [(f"{b} deg/h", {"sensors.gyro_bias": f"{b} deg/h"}) for b in (0.01, 0.03, 0.05)]),
-        ("fig1_accel_bias.png", "accelerometer bias",
-         [(f"{b / 1000:g} mg", {"sensors.accel_bias": f"{b} ug"}) for b in (100.0, 300.0, 500.0)]),
-        ("fig2_ratio.png", "ratio r = t_k1 / t_k2",
-         [(label, {"firmware.coarse_ratio": r}) for label, r in (("r = 1/4", 0.25), ("r = 1/2", 0.5),
-                                                                  ("r = 3/4", 0.75))]),
-    ]
-    for name, title, curves_of in panels:
-        fg, ax = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
-        for label, overrides in curves_of:
-            spec = run_spec("static", CURVES_HEADING, CURVES_SEED, {**CURVES, **overrides})
-            m, errs = spec.motion, spec.errors
-            res, e = navigate(spec)
-            # every record after the first coarse output holds a solution; they
-            # are all provisional (ATT_VALID unset) while the coarse phase runs
-            ok = e.time_s > DEFAULT_COARSE_FIRST_S
-            t = e.time_s[ok]
-            lim = analysis.alignment_limits(LAT, m.state(np.array([0.0])).euler[0], errs.gyro_bias,
-                                            errs.accel_bias).phi_n
-            d = e.att_n_rad[ok] - lim
-            ax[0].plot(t, np.abs(d[:, 2]) / ARCMIN, label=label)
-            ax[1].plot(t, np.abs(d[:, :2]).max(axis=1) / ARCSEC, label=label)
-            key = f"{name[:-4]}_{label.replace(' ', '').replace('/', '_')}_heading_vs_limit_at_150s_arcmin"
-            fig[key] = float(abs(d[t == 150.0, 2][0]) / ARCMIN)
-        ax[0].set_ylabel("|heading error - limit| [arcmin]")
-        ax[0].set_yscale("log")
-        ax[1].set_ylabel("max |level error - limit| [arcsec]")
-        ax[1].set_xlabel("alignment time [s]")
-        ax[0].legend()
-        ax[0].set_title(f"seed 000 static coarse alignment, heading 0: {title}\n"
-                        "error beside the theoretical limit (one noise seed)")
+    seeds = range(n_seeds)      # Table 1's seed formula at heading 0: 1000 * 0 + run
+    cols = " / ".join(map(str, RATIO_TIMES)) + " s"
+    md = [f"| method | r | heading RMS vs limit (') at {cols} | noise free, vs limit (') at {cols} |",
+          "|---|---|---|---|"]
+    fg, ax = plt.subplots(figsize=(8, 5))
+    styles = ["-", "--", ":", "-."]
+    for j, method in enumerate(methods):
+        for i, (r, label) in enumerate(RATIOS):
+            o = {"firmware.coarse_ratio": r, "firmware.coarse_method": method}
+            t, h = heading_series(o, seeds)
+            _, h0 = heading_series(o, [0], noise=False)
+            curve = rms(h)
+            ax.semilogy(t, curve, color=f"C{i}", ls=styles[j % 4], label=f"{method}, r = {label}")
+            ax.semilogy(t, np.abs(h0[0]), color=f"C{i}", ls=styles[j % 4], lw=0.6, alpha=0.6)
+            vals = [float(curve[at(t, tt)]) for tt in RATIO_TIMES]
+            free = [float(abs(h0[0, at(t, tt)])) for tt in RATIO_TIMES]
+            md.append(f"| {method} | {label} | " + " / ".join(f"{v:.3f}" for v in vals) + " | "
+                      + " / ".join(f"{v:.3f}" for v in free) + " |")
+            key = f"ratio_{method}_r{label.replace('/', '_')}"
+            fig[f"{key}_heading_rms_vs_limit_arcmin"] = dict(zip(map(str, RATIO_TIMES), vals))
+            fig[f"{key}_heading_noise_free_vs_limit_arcmin"] = dict(zip(map(str, RATIO_TIMES), free))
+    ax.set_xlabel("alignment time t_k2 [s]")
+    ax.set_ylabel("heading error - limit [arcmin]")
+    ax.set_title(f"seed 000 Fig. 2: static, heading 0; RMS over {n_seeds} noise seeds (thick),\n"
+                 "noise free (thin)")
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    fg.tight_layout()
+    fg.savefig(os.path.join(out, "fig2_ratio.png"), dpi=80)
+    plt.close(fg)
+    md.append("")
+    md.append(f"Static, heading 0, {n_seeds} noise seeds (0..{n_seeds - 1}); the heading error "
+              "against the theoretical limit, RMS over the seeds, and one noise-free run. The "
+              "paper: the smaller r, the faster the heading converges (no figures printed).")
+    text = "\n".join(md)
+    with open(os.path.join(out, "ratio.md"), "w") as f:
+        f.write(text + "\n")
+    return text
+
+
+def fig1(out, n_seeds, fig):
+    """The paper's Fig. 1 as it plots it: the heading error against the truth over time, for
+    three drifts and three biases (r = 1/2: the paper holds r fixed and does not say at what),
+    median and 5-95 % band over the seeds, each bias's limit dashed in its colour."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    seeds = range(n_seeds)
+    panels = [("fig1_gyro_bias.png", "gyro drift (accelerometer bias 0.1 mg)",
+               [(f"{b} deg/h", "sensors.gyro_bias", f"{b!r} deg/h") for b in FIG1_GYRO_DPH]),
+              ("fig1_accel_bias.png", "accelerometer bias (gyro drift 0.01 deg/h)",
+               [(f"{b / 1000:g} mg", "sensors.accel_bias", f"{b!r} ug") for b in FIG1_ACCEL_UG])]
+    cols = " / ".join(map(str, RATIO_TIMES)) + " s"
+    md = [f"| bias | limit (') | median heading err vs truth (') at {cols} | "
+          f"RMS vs limit (') at {cols} | noise free, vs limit (') at {cols} |", "|---|---|---|---|---|"]
+    for name, title, cases in panels:
+        fg, ax = plt.subplots(figsize=(8, 5))
+        for i, (label, key, value) in enumerate(cases):
+            t, h = heading_series({key: value}, seeds, vs_limit=False)
+            spec = run_spec("static", CURVES_HEADING, 0, {key: value})
+            lim = limit_euler(spec.motion, spec.errors, 0.0)[2] / 60.0
+            p5, med, p95 = np.percentile(h, [5.0, 50.0, 95.0], axis=0)
+            ax.plot(t, med, color=f"C{i}", label=f"{label}: median")
+            ax.fill_between(t, p5, p95, color=f"C{i}", alpha=0.2)
+            ax.axhline(lim, color=f"C{i}", ls="--", lw=1, label=f"{label}: limit")
+            _, h0 = heading_series({key: value}, [0], noise=False, vs_limit=False)
+            ax.plot(t, h0[0], color=f"C{i}", lw=0.6, alpha=0.7)
+            free = [float(h0[0, at(t, tt)] - lim) for tt in RATIO_TIMES]
+            med_t = [float(med[at(t, tt)]) for tt in RATIO_TIMES]
+            rms_t = [float(rms(h[:, at(t, tt)] - lim)) for tt in RATIO_TIMES]
+            md.append(f"| {label} | {lim:.3f} | " + " / ".join(f"{v:.3f}" for v in med_t) + " | "
+                      + " / ".join(f"{v:.3f}" for v in rms_t) + " | "
+                      + " / ".join(f"{v:+.4f}" for v in free) + " |")
+            k = f"fig1_{label.replace(' ', '').replace('/', 'p')}"
+            fig[f"{k}_heading_limit_arcmin"] = float(lim)
+            fig[f"{k}_median_heading_err_vs_truth_arcmin"] = dict(zip(map(str, RATIO_TIMES), med_t))
+            fig[f"{k}_heading_rms_vs_limit_arcmin"] = dict(zip(map(str, RATIO_TIMES), rms_t))
+            fig[f"{k}_heading_noise_free_vs_limit_arcmin"] = dict(zip(map(str, RATIO_TIMES), free))
+        ax.set_ylim(-25, 25)
+        ax.set_xlabel("alignment time [s]")
+        ax.set_ylabel("heading error (computed - true) [arcmin]")
+        ax.set_title(f"seed 000 Fig. 1: {title}\nstatic, heading 0, r = 1/2; median and 5-95 % "
+                     f"over {n_seeds} noise seeds; thin: noise free")
+        ax.legend(fontsize=8, ncol=2)
+        ax.grid(True, alpha=0.3)
         fg.tight_layout()
-        fg.savefig(os.path.join(out, name), dpi=100)
+        fg.savefig(os.path.join(out, name), dpi=80)
         plt.close(fg)
+    md.append("")
+    md.append(f"Static, heading 0, r = 1/2, {n_seeds} noise seeds and one noise-free run. The "
+              "heading error against the truth (the paper's Fig. 1 plots the heading's "
+              "convergence) and, beside it, against each bias's limit. The paper: the smaller "
+              "the drift or the bias, the faster the heading converges (no figures printed).")
+    text = "\n".join(md)
+    with open(os.path.join(out, "fig1.md"), "w") as f:
+        f.write(text + "\n")
+    return text
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join("runs", "seed000"))
     ap.add_argument("--seeds", type=int, default=5, help="noise seeds per heading (paper: 5)")
+    ap.add_argument("--ratio-seeds", type=int, default=30,
+                    help="noise seeds of the ratio study, Fig. 1's bands and the heading-noise split")
+    ap.add_argument("--methods", default="triad",
+                    help="coarse methods of the ratio study, comma separated (firmware.coarse_method)")
     args = ap.parse_args(argv)
+    methods = check_methods(args.methods)
     os.makedirs(args.out, exist_ok=True)
-    fig = {"noise_seeds": args.seeds, "latitude_deg": LAT / DEG}
+    fig = {"noise_seeds": args.seeds, "ratio_seeds": args.ratio_seeds, "methods": methods,
+           "latitude_deg": LAT / DEG}
     print("seed 000 static, errors at 150 s (Table 1 layout)")
-    print(table_static(args.out, args.seeds, fig))
+    print(table_static(args.out, args.seeds, fig, args.ratio_seeds))
     print("\nseed 000 swing, errors at 200 s")
     print(table_swing(args.out, args.seeds, fig))
-    curves(args.out, fig)
+    print("\nseed 000 Fig. 2, ratio r")
+    print(ratio_study(args.out, args.ratio_seeds, methods, fig))
+    print("\nseed 000 Fig. 1, biases")
+    print(fig1(args.out, args.ratio_seeds, fig))
     with open(os.path.join(args.out, "seed000.json"), "w") as f:
         json.dump(fig, f, indent=2)
     print(f"\nfigures, tables and seed000.json written to {args.out}")
