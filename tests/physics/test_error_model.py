@@ -5,11 +5,17 @@ static-INS error model of pyins.analysis driven by the same drifts
 projected through the recorded table angle. At 6, 12 and 24 h the heading,
 level and position errors agree within 10 % of each quantity's scale (its
 largest model value over the day: a relative test at a zero crossing would
-say nothing)."""
+say nothing).
+
+The error budget (issue 16, below): the model extended with scale-factor
+and misalignment errors under the run's table angle and ship attitude
+history (pyins.analysis.error_budget), each source against a run of the
+firmware with that error alone, the misalignment-times-tilt case among them."""
 import numpy as np
 import pytest
 
 from pyins import analysis, fil, metrics, sim
+from pyins.reference import attitude, earth
 from pyins import units
 
 DEG = units.DEG_TO_RAD
@@ -59,3 +65,162 @@ def test_drift_surviving_proxy():
     half = turn < np.pi
     assert analysis.drift_surviving(turn, half) == pytest.approx(1.0 / np.sin(np.pi / 3600) / 3600, rel=1e-9)
     assert analysis.drift_surviving(turn, half) == pytest.approx(analysis.drift_surviving(turn, ~half), rel=1e-9)
+
+
+# ---------------------------------------------------------------------------
+# The error budget (issue 16): scale factors and misalignments under the
+# actual table angle and ship attitude history, each source alone
+# ---------------------------------------------------------------------------
+from pyins import scenario  # noqa: E402
+
+
+def _spec(name, hours, overrides=None):
+    sc = scenario.load(name).with_overrides({"duration": f"{hours * 3600:g} s", "compare": None, "paper": None,
+                                             **(overrides or {})})
+    (spec,) = sc.runs()
+    return spec
+
+
+def test_discretization_matches_scipy_expm():
+    """Phi and Gamma of the stepped model against scipy's expm of the augmented
+    matrix (Van Loan): both are exact to rounding, 1e-12 relative leaves room for
+    the series' and the squarings' roundings only."""
+    from scipy.linalg import expm
+    f, gg, ga = analysis.error_matrix(LAT, 380.0)
+    g = np.hstack([gg, ga])
+    for h in (0.01, 1.0, 600.0):            # 600 s: the scaling and squaring branch
+        phi, gam = analysis.discretize(f, g, h)
+        aug = np.zeros((13, 13))
+        aug[:7, :7], aug[:7, 7:] = f * h, g * h
+        ref = expm(aug)
+        assert np.abs(phi - ref[:7, :7]).max() <= 1e-12 * np.abs(ref[:7, :7]).max()
+        assert np.abs(gam - ref[:7, 7:]).max() <= 1e-12 * np.abs(ref[:7, 7:]).max()
+
+
+def test_stepped_model_equals_rk4_static_model():
+    """Constant eps^n and nabla^n: the exactly stepped model (1 s steps) and the
+    RK4 static model (0.5 s) integrate the same equations; at 6 h they agree to
+    1e-6 of each quantity's scale (RK4's error ~ (omega_s h)^4 per step)."""
+    eps = np.array([0.002, -0.003, 0.004]) * units.DPH_TO_RPS
+    nab = np.array([30.0, -20.0, 0.0]) * units.UG_TO_MPS2
+    k = 6 * 3600
+    times, states = analysis.propagate_errors(LAT, 0.0, 1.0, np.tile(eps, (1, k, 1)), np.tile(nab, (1, k, 1)))
+    ref = analysis.static_error_model(LAT, np.array([3600.0, 6 * 3600.0]), eps, nab, step_s=0.5)
+    for i, t in enumerate((3600, 6 * 3600)):
+        x = states[0, t - 1]
+        assert times[t - 1] == t
+        assert np.abs(x[:3] - ref.att_n_rad[i]).max() <= 1e-6 * np.abs(ref.att_n_rad).max()
+        assert np.abs(x[3:5] - ref.vel_n_mps[i]).max() <= 1e-6 * np.abs(ref.vel_n_mps).max()
+
+
+def test_table_history_places_the_turns_start():
+    """A table at rest that starts turning at 6 deg/s 0.37 s into a 1-s record
+    interval (a motor that reaches its rate within a tick): the kinked
+    reconstruction gives the angle exactly (1e-12 rad), straight lines between
+    the records are off by 6 deg/s x 0.37 x 0.63 s = 1.4 deg there."""
+    r = 6.0 * DEG
+    t_rec = np.arange(1.0, 6.0)
+    true = lambda t: r * np.maximum(0.0, t - 2.37)          # noqa: E731
+    rate = np.where(t_rec > 2.37, r, 0.0)
+    fine = np.linspace(0.0, 5.0, 5001)
+    for kinks, bound in ((True, 1e-12), (False, 1.5 * DEG)):
+        tab = analysis.table_history(t_rec, true(t_rec), rate, kinks=kinks)
+        k = np.minimum((fine // 1.0).astype(int), 4)
+        tt = fine - tab.t0[k]
+        tau = tab.t_kink[k] - tab.t0[k]
+        alpha = tab.alpha0[k] + tab.rate0[k] * np.minimum(tt, tau) + tab.rate1[k] * np.maximum(0.0, tt - tau)
+        err = np.abs(alpha - true(fine)).max()
+        assert err <= bound
+        if not kinks:
+            assert err > 1.0 * DEG          # the reconstruction is what makes the difference
+
+
+def test_drive_of_a_bias_on_a_fixed_ship_is_its_projection():
+    """A gyro bias on a ship at rest with the table fixed at 30 deg: the mean eps^n
+    over every interval is C_b^n Rz(30 deg) b (to rounding), and a scale factor
+    sees the Earth's rate only (|eps| = 10 ppm x 15 deg/h)."""
+    euler = np.array([1.0, -2.0, -15.0]) * DEG
+    m = sim.Static(LAT, 0.0, 0.0, *euler)
+    b = np.array([1.0, -2.0, 3.0]) * 0.001 * units.DPH_TO_RPS
+    tab = analysis.table_history(np.arange(1.0, 11.0), np.full(10, 30 * DEG), np.zeros(10), alpha0=30 * DEG)
+    eps, nab = analysis.error_drive(m, tab, [sim.SensorErrors(gyro_bias=b),
+                                             sim.SensorErrors(gyro_scale=np.full(3, 10e-6))])
+    want = attitude.euler_to_mat(euler) @ attitude.rot_z(30 * DEG) @ b
+    assert np.abs(eps[0] - want).max() <= 1e-15 * np.abs(want).max() * 10
+    assert np.allclose(np.linalg.norm(eps[1], axis=1), 10e-6 * earth.OMEGA_IE, rtol=1e-9)
+    assert np.all(nab == 0.0)
+
+
+def test_misalignment_times_tilt_times_swing():
+    """Seed 002 exp. 2, the traditional two-position scheme, the six gyro
+    misalignments (+10") as the only error, 12 h: the deck's tilt times the
+    misalignment times the 6 deg/s yaw swing, locked to the table's turns,
+    rectifies into a mean up drift (~0.005 deg/h, more than the up gyro's
+    0.003 deg/h) that no vertical-axis table modulates. The model (driven
+    by the run's table history and the analytic swing) follows the firmware
+    within 2 % of the run's largest error over the whole run: measured
+    0.05 % at 72 h; the model's own approximations (first order in the
+    errors, the interval's forcing held constant) are below 0.1 %, while
+    leaving out the tilt term changes the result by more than 10 % (checked
+    below), so 2 % tells a right model from one that misses it. The model
+    that knows constant drifts only (what analysis had before) predicts
+    nothing here."""
+    mis = sim.preset("seed002").gyro_misalignment
+    out = {}
+    for deck, over in (("tilted", {}), ("level", {"motion.pitch": "0 deg", "motion.roll": "0 deg"})):
+        spec = _spec("seed002_exp2", 12, {"initial_errors": None, "indexing.scheme": "two_position", **over})
+        errors = sim.SensorErrors(gyro_misalignment=mis)
+        res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=errors, table=spec.table,
+                          every=100)
+        nav = metrics.nav_errors(res)
+        budget = analysis.error_budget(spec.motion, res, errors, spec.config, keep_every=10)
+        cmp = analysis.compare_with_run(budget.errors("gyro_misalignment"), nav)
+        print(deck, cmp, budget.eps_n_mean / units.DPH_TO_RPS)
+        assert cmp["rel_max"] <= 0.02, deck
+        out[deck] = (budget, nav)
+    eps_u = out["tilted"][0].eps_n_mean[0, 2] / units.DPH_TO_RPS
+    assert 0.004 <= eps_u <= 0.006                  # the rectified up drift [deg/h]
+    assert abs(out["level"][0].eps_n_mean[0, 2] / units.DPH_TO_RPS) < 0.0002
+    tilted, level = (out[d][1].horizontal_m[-1] for d in ("tilted", "level"))
+    assert tilted > 1.1 * level                     # the tilt term is more than 10 % of the result at 12 h
+    assert tilted > 0.5 * units.NMI_TO_M
+
+
+def test_records_only_drive_is_close():
+    """Without the motion (the firmware's 1-s attitude records alone) the same case
+    comes within 2 % (measured 0.7 % at 72 h): one sample per interval misses the
+    turns' corners and the swing's curvature inside it."""
+    mis = sim.preset("seed002").gyro_misalignment
+    spec = _spec("seed002_exp2", 6, {"initial_errors": None, "indexing.scheme": "two_position"})
+    errors = sim.SensorErrors(gyro_misalignment=mis)
+    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=errors, table=spec.table, every=100)
+    budget = analysis.error_budget(spec.motion, res, errors, spec.config, from_records=True, keep_every=10)
+    cmp = analysis.compare_with_run(budget.errors("gyro_misalignment"), metrics.nav_errors(res))
+    assert cmp["rel_max"] <= 0.02
+
+
+@pytest.mark.parametrize("name, scheme", [("seed002_exp1", "flexible"), ("seed003", "single_position")])
+def test_every_source_alone_and_their_sum(name, scheme):
+    """Every source of the scenario's sensor set (gyro and accelerometer bias,
+    scale factor, misalignment) and its initial errors, each alone through the
+    firmware (6 h), and all together: the model within 10 % of each run's
+    largest horizontal error (issue 16's line; measured <= 0.05 %). A source
+    whose run stays below 1 m (seed 002's uniform accelerometer scale factor acts
+    along the held vertical only: exactly nothing horizontal) is held in
+    absolute terms: within 0.1 m."""
+    spec = _spec(name, 6, {"indexing.scheme": scheme})
+    rows, budget = analysis.run_budget(spec, check=True)
+    names = {r["source"] for r in rows}
+    assert set(analysis.SOURCES) <= names and "sum" in names
+    assert (analysis.INITIAL in names) == name.startswith("seed002")
+    for r in rows:
+        print(r["source"], r["rel_max"], r["diff_max_m"], r["run_max_m"])
+        if r["run_max_m"] >= 1.0:
+            assert r["rel_max"] <= 0.10, r["source"]
+        else:
+            assert r["diff_max_m"] <= 0.1, r["source"]
+    # the budget's sum (all sources on the all-errors run's table history) is the sum of its rows
+    total = budget.errors()
+    parts = [budget.errors(n) for n in budget.names]
+    assert np.abs(total.north_m - sum(p.north_m for p in parts)).max() <= 1e-9 * np.abs(total.north_m).max()
+    assert np.abs(total.att_n_rad - sum(p.att_n_rad for p in parts)).max() <= 1e-9 * np.abs(total.att_n_rad).max()
