@@ -124,6 +124,17 @@ def pyins_index_reset(fw):
     return abi.PYINS_OK
 
 
+def _records(status, n_done, records, dtype):
+    """The record dicts of a decimated run as an array of ``dtype``;
+    SampleError (carrying them) when the run stopped at a rejected sample."""
+    out = np.zeros(len(records), dtype=dtype)
+    for rec, o in zip(out, records):
+        fill(rec, o)
+    if status != abi.PYINS_OK:
+        raise native.SampleError(status, n_done, out)
+    return out
+
+
 class _StateUnpickler(pickle.Unpickler):
     """Rebuilds the mirror's own classes and NumPy arrays, nothing else."""
 
@@ -186,13 +197,7 @@ class Firmware:
             every = int(every)
             if every < 1:
                 raise ValueError(f"every: must be a positive number of ticks, got {every}")
-            status, n_done, records = pyins_run_decimated(self._fw, samples, every)
-            out = np.zeros(len(records), dtype=native.OUTPUT_DTYPE)
-            for rec, o in zip(out, records):
-                fill(rec, o)
-            if status != abi.PYINS_OK:
-                raise native.SampleError(status, n_done, out)
-            return out
+            return _records(*pyins_run_decimated(self._fw, samples, every), native.OUTPUT_DTYPE)
         if outputs is None:
             outputs = np.zeros(n, dtype=native.OUTPUT_DTYPE)
         elif (not isinstance(outputs, np.ndarray) or outputs.dtype != native.OUTPUT_DTYPE
@@ -211,13 +216,7 @@ class Firmware:
         every = int(every)
         if every < 1:
             raise ValueError(f"every: must be a positive number of ticks, got {every}")
-        status, n_done, records = pyins_run_nav(self._fw, samples, every)
-        out = np.zeros(len(records), dtype=native.NAV_DTYPE)
-        for rec, o in zip(out, records):
-            fill(rec, o)
-        if status != abi.PYINS_OK:
-            raise native.SampleError(status, n_done, out)
-        return out
+        return _records(*pyins_run_nav(self._fw, samples, every), native.NAV_DTYPE)
 
     def nav(self):
         """The current state as one NAV_DTYPE record."""

@@ -593,29 +593,16 @@ class Firmware:
         }
 
     def output(self):
-        lat, lon, height, vel, q_np, q_nb, state_flags = self.solution()
-        euler_b = attitude.quat_to_euler(q_nb)
+        out = self.nav_record()      # the fields both records share, from solution()
+        euler_b = attitude.quat_to_euler(out["quat_nb"])
         return {
-            "tick": self.tick,
-            "mode": self.mode,
-            "fault_flags": self.faults,
-            "state_flags": state_flags,
-            "lat_rad": lat,
-            "lon_rad": lon,
-            "height_m": height,
-            "vel_n_mps": vel,
-            "quat_nb": q_nb,
-            "quat_np": q_np,
+            **out,
             "euler_b_rad": euler_b,
             "heading_b_rad": attitude.yaw_to_heading(euler_b[2]),
             "yaw_p_rad": wrap_pi(euler_b[2] + self.encoder),
-            "table_angle_rad": self.table_angle,
-            "index_state": self.idx.state,
             "index_step": self.idx.step,
             "index_fault": self.idx.fault,
             "index_fallbacks": self.idx.fallbacks,
-            "motor_rate_cmd_rad_s": self.idx.cmd_rate,
-            "table_angle_cmd_rad": self.idx.cmd_angle,
             "index_a_c": self.idx.a_c,
             "index_a_s": self.idx.a_s,
             "kf_states": self.kf_states,
