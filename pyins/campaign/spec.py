@@ -25,6 +25,7 @@ Written three ways: a campaign file (`load_campaign`, `loads_campaign`),
 a built-in of pyins/campaigns/ (`list_builtin`, `builtin_path`), or
 command-line arguments (`from_args`).
 """
+import copy
 import difflib
 import hashlib
 import itertools
@@ -32,6 +33,8 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 try:
     import tomllib
@@ -49,7 +52,7 @@ __all__ = ["Campaign", "Point", "load_campaign", "loads_campaign", "from_args", 
 
 BUILTIN_DIR = Path(__file__).resolve().parent.parent / "campaigns"   #: the built-in campaigns
 CAMPAIGN_KEYS = ("name", "title", "description", "scenario", "seeds", "seed_formula", "group_by",
-                 "compare", "grid", "set", "labels")
+                 "compare", "grid", "set", "labels", "random_constants")
 
 
 @dataclass(frozen=True)
@@ -94,6 +97,7 @@ class Campaign:
     source: str
     points: list = field(default_factory=list)
     groups: list = field(default_factory=list)   #: [{values: {key: value}, label: str}]
+    random_constants: object = None   #: sensor preset whose random constants each run draws, or None
 
     def __repr__(self):
         return (f"Campaign({self.name!r}, {len(self.points)} runs in {len(self.groups)} group(s), "
@@ -119,6 +123,7 @@ class Campaign:
                 "grid": self.grid, "labels": {k: v[1] for k, v in self.labels.items()},
                 "seeds": self.seeds, "seed_formula": self.seed_formula, "group_by": self.group_by,
                 "set": self.overrides, "compare": self.compare, "variants": self.variants,
+                **({"random_constants": self.random_constants} if self.random_constants else {}),
                 "digest": self.digest()}
 
     show = staticmethod(show)          #: a value as written (strings as they are, else JSON)
@@ -157,9 +162,39 @@ def _rewrap(exc, key, source, prefix=""):
     return ScenarioError(prefix + inner, key, source)
 
 
+def _check_random_constants(preset, grid, fixed, seeds, source):
+    """``random_constants``: a sensor preset; needs seeds (the draws); the
+    campaign may not set the terms it draws."""
+    from pyins.sim import sensors
+    where = "campaign.random_constants"
+    if not isinstance(preset, str) or preset not in sensors.PRESETS:
+        close = difflib.get_close_matches(str(preset), list(sensors.PRESETS), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise ScenarioError(f"{preset!r} is not a sensor preset; {hint}(presets: "
+                            f"{', '.join(sensors.PRESETS)})", where, source)
+    if not any(np.any(getattr(sensors.PRESETS[preset], t) != 0.0)
+               for t, _, _ in sensors.RANDOM_CONSTANT_TERMS):
+        raise ScenarioError(f"the preset {preset!r} has no random constants to draw", where, source)
+    if seeds is None:
+        raise ScenarioError("needs campaign.seeds: each seeds entry is one draw", where, source)
+    drawn = {f"sensors.{t}" for t, _, _ in sensors.RANDOM_CONSTANT_TERMS}
+    for table, keys in (("set", fixed), ("grid", grid)):
+        for key in keys:
+            if key in drawn or key in ("sensors", "sensors.preset"):
+                raise ScenarioError(f"drawn by campaign.random_constants = {preset!r}: do not set it",
+                                    qkey(table, key), source)
+
+
 def _build(base, scenario_ref, grid, seeds, group_by, *, overrides=None, seed_formula=None,
-           compare="auto", labels=None, name=None, title=None, description="", source="command line"):
-    """Validate everything and expand the points (ScenarioError: one line)."""
+           compare="auto", labels=None, name=None, title=None, description="", source="command line",
+           random_constants=None):
+    """Validate everything and expand the points (ScenarioError: one line).
+
+    ``random_constants``: a sensor preset name (`pyins.sim.sensors`): every
+    point sets ``sensors.preset`` to it and replaces its random constants
+    (biases, scale-factor and installation errors) by draw ``run`` (the
+    seeds entry) of `pyins.sim.sensors.random_constant_overrides`, so every
+    grid point of one ``run`` has the same constants (paired comparisons)."""
     grid = dict(grid or {})
     fixed = dict(overrides or {})
     # 1. grid and fixed keys: scenario keys, not the campaign's own business
@@ -203,6 +238,8 @@ def _build(base, scenario_ref, grid, seeds, group_by, *, overrides=None, seed_fo
         lab[key] = ([canonical(v) for v in grid[key]], list(names))
     # 3. seeds and their formula
     seeds = parse_seeds(seeds, "campaign.seeds", source)
+    if random_constants is not None:
+        _check_random_constants(random_constants, grid, fixed, seeds, source)
     formula = None
     names = formula_names(grid)
     if seed_formula is not None:
@@ -277,6 +314,8 @@ def _build(base, scenario_ref, grid, seeds, group_by, *, overrides=None, seed_fo
         for run in (seeds if seeds is not None else [None]):
             ov = dict(common)
             ov.update(values)
+            if random_constants is not None:
+                ov.update(_drawn(random_constants, run))
             seed = run
             if formula is not None:
                 env = {"run": run, "point": ci}
@@ -328,7 +367,16 @@ def _build(base, scenario_ref, grid, seeds, group_by, *, overrides=None, seed_fo
     return Campaign(name=name, title=title or name, description=description or "", base=base,
                     scenario_ref=scenario_ref, grid=grid, seeds=seeds, seed_formula=seed_formula,
                     group_by=group_by, overrides=fixed, compare=compare, labels=lab, source=source,
-                    points=points, groups=groups)
+                    points=points, groups=groups, random_constants=random_constants)
+
+
+def _drawn(preset, run, _cache={}):
+    """The overrides of draw ``run`` of ``preset`` (cached: one per draw, not per point)."""
+    key = (preset, run)
+    if key not in _cache:
+        from pyins.sim import sensors
+        _cache[key] = {"sensors.preset": preset, **sensors.random_constant_overrides(preset, run)}
+    return copy.deepcopy(_cache[key])
 
 
 def _flatten(table, where, source):
@@ -408,7 +456,7 @@ def loads_campaign(text, source="<string>", name=None, relative_to=None):
     return _build(base, c["scenario"], grid, c.get("seeds"), c.get("group_by"), overrides=fixed,
                   seed_formula=c.get("seed_formula"), compare=c.get("compare", "auto"), labels=labels,
                   name=c.get("name", name), title=c.get("title"), description=c.get("description", ""),
-                  source=source)
+                  source=source, random_constants=c.get("random_constants"))
 
 
 def builtin_path(name):
@@ -432,7 +480,7 @@ def list_builtin():
 
 
 def from_args(scenario, grid_strings=(), seeds=None, group_by=None, *, overrides=None,
-              seed_formula=None, compare="auto", name=None, title=None):
+              seed_formula=None, compare="auto", name=None, title=None, random_constants=None):
     """A Campaign from command-line style arguments.
 
     ``scenario``: a built-in name, a path or a Scenario; ``grid_strings``:
@@ -441,7 +489,8 @@ def from_args(scenario, grid_strings=(), seeds=None, group_by=None, *, overrides
     ("5", "0,3,7", "2..6"); ``group_by``: grid keys (list or "a,b"; None:
     every grid key); ``overrides``: ["duration=30 s", ...] or a dict, set on
     every run; ``seed_formula``: e.g. "1000 * heading + run"; ``compare``:
-    "auto", "keep" or "drop" (the base's [compare]).
+    "auto", "keep" or "drop" (the base's [compare]); ``random_constants``: a
+    sensor preset whose random constants each seeds entry draws (`_build`).
     """
     source = "command line"
     if isinstance(scenario, scenario_mod.Scenario):
@@ -452,7 +501,8 @@ def from_args(scenario, grid_strings=(), seeds=None, group_by=None, *, overrides
     if not grid and seeds is None:
         raise ScenarioError("a campaign needs a grid (KEY=V1,V2,...) or seeds", "", source)
     return _build(base, ref, grid, seeds, group_by, overrides=parse_overrides(overrides),
-                  seed_formula=seed_formula, compare=compare, name=name, title=title, source=source)
+                  seed_formula=seed_formula, compare=compare, name=name, title=title, source=source,
+                  random_constants=random_constants)
 
 
 def default_out_dir(camp):

@@ -27,6 +27,10 @@ conversions used by the presets: 1 deg/sqrt(h) = DEG_TO_RAD / 60 rad/sqrt(s);
 3. The model applied chunk by chunk: `SensorModel`.
 4. The presets: `PRESETS`, `preset` (the papers' sensor set-ups as the
    project reads them, docs/papers.md).
+5. Random-constant draws: `random_constant_values`, `random_constant_overrides`,
+   `draw_random_constants` (each random constant of a preset drawn as
+   N(0, sigma^2) with sigma its preset value; Monte-Carlo campaigns,
+   docs/results/montecarlo.md).
 """
 from dataclasses import dataclass, field, replace
 
@@ -271,3 +275,90 @@ def preset(name, gyro_bias_signs=(1.0, 1.0, 1.0), accel_bias_signs=(1.0, 1.0, 1.
                    accel_bias=p.accel_bias * np.asarray(accel_bias_signs, dtype=float),
                    accel_scale=p.accel_scale.copy(),
                    accel_misalignment=p.accel_misalignment.copy())
+
+
+# ---------------------------------------------------------------------------
+# 5. Random-constant draws (Monte Carlo over the papers' stated 1-sigma values)
+# ---------------------------------------------------------------------------
+#: The terms a paper states as random constants, in the order their standard
+#: normals are drawn, with the unit a scenario file writes them in.
+RANDOM_CONSTANT_TERMS = (("gyro_bias", "deg/h", DPH_TO_RPS), ("gyro_scale", "ppm", PPM),
+                         ("gyro_misalignment", "arcsec", ARCSEC_TO_RAD),
+                         ("accel_bias", "ug", UG_TO_MPS2), ("accel_scale", "ppm", PPM),
+                         ("accel_misalignment", "arcsec", ARCSEC_TO_RAD))
+#: Mixed into every draw's seed so that draw ``d`` is not the noise stream of
+#: ``numpy.random.default_rng(d)`` (the scenario seed of the same run).
+RANDOM_CONSTANT_SALT = 0x5EED_C0DE
+
+
+def _sigma_in_unit(value_si, factor):
+    """A preset's +1-sigma value in the file's unit, rounded to 12 significant
+    digits (0.003 deg/h, not 0.0030000000000000005)."""
+    return np.vectorize(lambda x: float(f"{x / factor:.12g}") if x != 0.0 else 0.0,
+                        otypes=[float])(np.abs(np.asarray(value_si, dtype=float)))
+
+
+def random_constant_normals(draw):
+    """The 30 standard normals of draw ``draw`` (int >= 0): gyro bias (3),
+    gyro scale (3), gyro misalignment (3x3, row by row), accelerometer bias
+    (3), scale (3), misalignment (3x3), from PCG64 seeded with
+    SeedSequence([RANDOM_CONSTANT_SALT, draw]). Every element is drawn even
+    where a preset's sigma is zero, so draw d has the same normals under
+    every preset (seed 002 and seed 003 draw d share them)."""
+    if isinstance(draw, bool) or not isinstance(draw, (int, np.integer)) or draw < 0:
+        raise ValueError(f"a draw must be an integer >= 0, got {draw!r}")
+    rng = np.random.default_rng(np.random.SeedSequence([RANDOM_CONSTANT_SALT, int(draw)]))
+    return rng.standard_normal(30)
+
+
+def random_constant_values(name, draw):
+    """Draw ``draw`` of preset ``name``'s random constants, in file units.
+
+    The papers state their drifts, biases, scale-factor and installation
+    errors as random constants (随机常值) with a 1-sigma value; the presets
+    hold +1 sigma on every term, one particular draw. Here every term that
+    is non-zero in the preset is drawn independently as N(0, sigma^2) with
+    sigma = |preset value| (signs and magnitudes both random); terms the
+    preset leaves zero stay zero (e.g. seed 002's upper-triangle
+    accelerometer installation terms, every diagonal). The noise terms
+    (ARW, VRW, quantum) are not random constants and stay the preset's; their
+    random stream is the scenario's ``seed``.
+
+    Returns {term: (values, unit)} with values a (3,) or (3, 3) array in
+    ``unit`` (deg/h, ppm, arcsec, ug).
+    """
+    if name not in PRESETS:
+        raise ValueError(f"unknown sensor preset {name!r}; choose one of {sorted(PRESETS)}")
+    z = random_constant_normals(draw)
+    p = PRESETS[name]
+    out, i = {}, 0
+    for term, unit, factor in RANDOM_CONSTANT_TERMS:
+        sigma = _sigma_in_unit(getattr(p, term), factor)
+        n = sigma.size
+        out[term] = (sigma * z[i:i + n].reshape(sigma.shape), unit)
+        i += n
+    return out
+
+
+def random_constant_overrides(name, draw):
+    """Draw ``draw`` of preset ``name`` (`random_constant_values`) as scenario
+    overrides: {"sensors.gyro_bias": ["0.0012 deg/h", ...], ...}, each number
+    written with repr (exact round trip), zeros as 0. With ``sensors.preset``
+    = ``name`` these replace every random constant of the preset."""
+    def text(x, unit):
+        return 0 if x == 0.0 else f"{float(x)!r} {unit}"
+    out = {}
+    for term, (values, unit) in random_constant_values(name, draw).items():
+        if values.ndim == 1:
+            out[f"sensors.{term}"] = [text(x, unit) for x in values]
+        else:
+            out[f"sensors.{term}"] = [[text(x, unit) for x in row] for row in values]
+    return out
+
+
+def draw_random_constants(name, draw):
+    """`SensorErrors` of preset ``name`` with its random constants replaced by
+    draw ``draw`` (`random_constant_values`); noise terms as the preset's."""
+    vals = random_constant_values(name, draw)
+    factors = {term: factor for term, _, factor in RANDOM_CONSTANT_TERMS}
+    return replace(PRESETS[name], **{t: v * factors[t] for t, (v, _) in vals.items()})

@@ -1,0 +1,199 @@
+"""Monte Carlo over the papers' random constants (issue 16): the draw is
+N(0, sigma^2) per non-zero preset term with a fixed stream per draw; a
+campaign with ``random_constants`` gives every scheme of one draw the same
+constants (paired) and a new draw new ones; its mistakes are one line; the
+small Monte-Carlo campaign gives identical aggregates locally and on a Dask
+LocalCluster; the report's statistics (percentile, Clopper-Pearson)."""
+import importlib.util
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pyins import campaign, scenario
+from pyins.scenario import ScenarioError
+from pyins.sim import sensors
+from pyins.units import ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools" / "papers"
+
+
+def _driver():
+    spec = importlib.util.spec_from_file_location("montecarlo_driver", TOOLS / "montecarlo.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+# ---------------------------------------------------------------------------
+# The draw
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["seed002", "seed003"])
+def test_draws_are_zero_mean_with_the_preset_sigma(name):
+    """2000 draws: per term, mean 0 and std = |preset value| (the stated 1
+    sigma); zero preset terms stay zero. With n = 2000 the sample std of a
+    normal scatters by sigma / sqrt(2 n) = 1.6 % and the mean by sigma /
+    sqrt(n) = 2.2 % of sigma: 6 % and 9 % are about 4 of those, so a draw
+    with a wrong sigma (e.g. the preset's +1 sigma times 0.9, or a uniform
+    of the same range, std 0.58 sigma) fails."""
+    n = 2000
+    p = sensors.PRESETS[name]
+    factors = {t: f for t, _, f in sensors.RANDOM_CONSTANT_TERMS}
+    samples = {t: np.array([sensors.random_constant_values(name, d)[t][0] for d in range(n)]) * factors[t]
+               for t in factors}
+    for term, s in samples.items():
+        sigma = np.abs(getattr(p, term))
+        zero = sigma == 0.0
+        assert np.all(s[:, zero] == 0.0), term
+        if np.all(zero):
+            continue
+        std = s[:, ~zero].std(axis=0, ddof=1)
+        mean = s[:, ~zero].mean(axis=0)
+        np.testing.assert_allclose(std, sigma[~zero], rtol=0.06, err_msg=term)
+        assert np.all(np.abs(mean) < 0.09 * sigma[~zero]), term
+        assert np.all((s[:, ~zero] > 0).mean(axis=0) > 0.45), f"{term}: both signs are drawn"
+
+
+def test_a_draw_is_reproducible_and_its_stream_fixed():
+    """Draw 0 of seed002 is pinned (a change of the salt, order or generator
+    changes every Monte-Carlo run and its digest); the up gyro of draw 0 is
+    pinned to 1e-15 deg/h, far below any change of stream (O(sigma))."""
+    v = sensors.random_constant_values("seed002", 0)
+    assert v["gyro_bias"][1] == "deg/h"
+    np.testing.assert_allclose(v["gyro_bias"][0], [0.0028437713168923528, 0.000382623415782682,
+                                                   0.005642530789345591], rtol=0, atol=1e-15)
+    again = sensors.random_constant_values("seed002", 0)
+    assert all(np.array_equal(again[t][0], v[t][0]) for t in v)
+    other = sensors.random_constant_values("seed002", 1)
+    assert not np.array_equal(other["gyro_bias"][0], v["gyro_bias"][0])
+    # the same normals under both presets: seed 003's draw 0 is seed 002's scaled by the sigmas
+    v3 = sensors.random_constant_values("seed003", 0)
+    np.testing.assert_allclose(v3["gyro_bias"][0], v["gyro_bias"][0], rtol=1e-12)   # both 0.003 deg/h
+    np.testing.assert_allclose(v3["accel_bias"][0], v["accel_bias"][0] * 20.0 / 30.0, rtol=1e-12)
+    with pytest.raises(ValueError, match="integer >= 0"):
+        sensors.random_constant_values("seed002", -1)
+    with pytest.raises(ValueError, match="unknown sensor preset"):
+        sensors.random_constant_values("seed009", 0)
+
+
+@pytest.mark.parametrize("draw", [0, 7])
+def test_overrides_give_the_drawn_errors(draw):
+    """The overrides written as text give, once resolved by the scenario, the
+    SensorErrors of draw_random_constants: to 1e-15 relative (one rounding
+    of the unit conversion), the noise terms kept as the preset's."""
+    sc = scenario.load("seed002_exp1").with_overrides(
+        {"compare": None, "paper": None, **sensors.random_constant_overrides("seed002", draw)})
+    spec = next(sc.runs())
+    want = sensors.draw_random_constants("seed002", draw)
+    got = spec.errors
+    for t, _, _ in sensors.RANDOM_CONSTANT_TERMS:
+        np.testing.assert_allclose(getattr(got, t), getattr(want, t), rtol=1e-15, atol=0, err_msg=t)
+    assert got.gyro_arw == sensors.PRESETS["seed002"].gyro_arw
+    assert got.accel_vrw == sensors.PRESETS["seed002"].accel_vrw
+    # the drawn up-gyro drift in SI: N(0, (0.003 deg/h)^2) times the normal
+    z = sensors.random_constant_normals(draw)
+    assert got.gyro_bias[2] == pytest.approx(z[2] * 0.003 * DPH_TO_RPS, rel=1e-12)
+    assert got.accel_bias[0] == pytest.approx(z[15] * 30.0 * UG_TO_MPS2, rel=1e-12)
+    assert got.gyro_misalignment[1, 0] == pytest.approx(z[9] * 10.0 * ARCSEC_TO_RAD, rel=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# The campaign
+# ---------------------------------------------------------------------------
+def test_builtin_montecarlo_campaigns_are_paired():
+    """seed002_montecarlo: 4 schemes x 2 swings x 100 draws; every point of
+    draw d carries draw d's constants and noise seed d, whatever its scheme
+    and experiment; two draws differ; the definition names the preset."""
+    camp = campaign.load_campaign("seed002_montecarlo")
+    assert len(camp.points) == 800 and len(camp.groups) == 8
+    assert camp.describe()["random_constants"] == "seed002"
+    by_run = {}
+    for p in camp.points:
+        drawn = {k: v for k, v in p.overrides.items() if k.startswith("sensors.")}
+        assert drawn["sensors.preset"] == "seed002"
+        assert p.seed == p.run
+        by_run.setdefault(p.run, []).append(json.dumps(drawn, sort_keys=True))
+    assert all(len(set(v)) == 1 and len(v) == 8 for v in by_run.values())
+    assert len({v[0] for v in by_run.values()}) == 100
+    c3 = campaign.load_campaign("seed003_montecarlo")
+    assert len(c3.points) == 200
+    assert c3.points[0].overrides["sensors.gyro_bias"] == c3.points[100].overrides["sensors.gyro_bias"]
+
+
+def test_random_constants_mistakes_are_one_line(tmp_path):
+    base = """[campaign]\nscenario = "seed003"\ncompare = "drop"\n"""
+    cases = [
+        (base + 'random_constants = "seed002"\n[campaign.grid]\n"indexing.scheme" = ["none"]\n',
+         "campaign.random_constants: needs campaign.seeds"),
+        (base + 'seeds = 2\nrandom_constants = "sed003"\n',
+         "'sed003' is not a sensor preset; did you mean 'seed003'?"),
+        (base + 'seeds = 2\nrandom_constants = "error_free"\n', "has no random constants"),
+        (base + 'seeds = 2\nrandom_constants = "seed003"\n[campaign.grid]\n'
+                '"sensors.gyro_bias" = ["0.001 deg/h", "0.002 deg/h"]\n',
+         'campaign.grid."sensors.gyro_bias": drawn by campaign.random_constants'),
+    ]
+    for text, msg in cases:
+        with pytest.raises(ScenarioError) as exc:
+            campaign.loads_campaign(text, source="mc.toml")
+        line = str(exc.value)
+        assert "\n" not in line and line.startswith("mc.toml: ") and msg in line, line
+
+
+def test_without_random_constants_nothing_changes():
+    """A campaign without the key keeps its points' overrides and digests:
+    seed002_schemes draws nothing and its definition has no such entry."""
+    camp = campaign.load_campaign("seed002_schemes")
+    assert "random_constants" not in camp.describe()
+    assert not any(k.startswith("sensors.") for p in camp.points for k in p.overrides)
+
+
+def test_local_and_dask_give_identical_montecarlo_aggregates(tmp_path):
+    """3 draws x 2 schemes x 1 h (seed 002 exp. 1) on a local pool and on a
+    Dask LocalCluster of 2 processes: campaign.json (every point's metrics
+    and the aggregates) is identical but for ``execution``. Also: the two
+    schemes of one draw differ (the runs are real), and two draws differ."""
+    pytest.importorskip("distributed")
+    mc = _driver()
+    same, local, dask, _ = mc.dask_identity(str(tmp_path), draws=3, hours=1, workers=2)
+    assert local["execution"]["computed"] == 6 and dask["execution"]["computed"] == 6
+    assert dask["execution"]["scheduler"].startswith("dask tcp://")
+    assert same
+    h = [p["metrics"][""]["horizontal_error_final_m"] for p in local["points"]]
+    assert len(set(h)) == 6
+
+
+# ---------------------------------------------------------------------------
+# The report's statistics
+# ---------------------------------------------------------------------------
+def test_report_statistics():
+    """Clopper-Pearson 90 %: 0 of 10 gives [0, 0.259] (1 - 0.05^(1/10)), 10
+    of 10 [0.741, 1]; 50 of 100 about [0.413, 0.587] (to 1e-3: the exact
+    beta quantiles). The paper's percentile: the share of draws below it,
+    ties counted half."""
+    mc = _driver()
+    lo, hi = mc.clopper_pearson(0, 10)
+    assert lo == 0.0 and hi == pytest.approx(1 - 0.05 ** 0.1, abs=1e-9)
+    lo, hi = mc.clopper_pearson(10, 10)
+    assert hi == 1.0 and lo == pytest.approx(0.05 ** 0.1, abs=1e-9)
+    lo, hi = mc.clopper_pearson(50, 100)
+    assert lo == pytest.approx(0.413, abs=1e-3) and hi == pytest.approx(0.587, abs=1e-3)
+    assert mc.percentile_of([1, 2, 3, 4], 2.5) == 50.0
+    assert mc.percentile_of([1, 2, 3, 4], 2) == pytest.approx(37.5)
+    assert mc.percentile_of([1, 2, 3, 4], 0.5) == 0.0 and mc.percentile_of([1, 2, 3, 4], 9) == 100.0
+    assert math.isclose(mc.percentile_of(np.arange(100), 89.5), 90.0)
+
+
+def test_first_draws_shares_the_runs():
+    """The driver's blocks: the first n draws of the campaign (and a scheme
+    subset) keep the whole campaign's digests, so the blocks resume into
+    the same run directories."""
+    mc = _driver()
+    camp = campaign.load_campaign("seed002_montecarlo")
+    sub = mc.first_draws(camp, 3, ["none", "flexible"])
+    assert len(sub.points) == 3 * 2 * 2
+    assert [p.index for p in sub.points] == list(range(12))
+    whole = {(p.run, p.values["indexing.scheme"], p.values["motion.period"]): p.digest for p in camp.points}
+    for p in sub.points:
+        assert whole[(p.run, p.values["indexing.scheme"], p.values["motion.period"])] == p.digest
