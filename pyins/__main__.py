@@ -7,6 +7,7 @@ Commands (``pyins COMMAND --help`` shows an example for each; docs/cli.md):
     replay LOG         run a recorded IMU log through the firmware
     report RUNDIR      (re)render the plots and report.html of a run directory
     campaign           grids and Monte-Carlo sets, local process pool or Dask
+    budget SCENARIO    each sensor error's share of the position error (linear model)
     list               built-in scenarios, campaigns, presets, schemes, formats
     bench              benchmark figures (C++ vs the NumPy reference)
     demo               the main job of tools/setup.sh (2 h seed-002 swing)
@@ -405,6 +406,47 @@ def cmd_campaign(args):
     return EXIT_OK
 
 
+def cmd_budget(args):
+    """Each sensor error's signed share of a scenario's errors: the linear model of
+    pyins.analysis.run_budget on one closed-loop run per variant; --check runs every
+    source alone through the firmware too (docs/concepts.md, "The error budget")."""
+    from pyins import analysis
+    scn = scenario.load(args.scenario)
+    overrides = {}
+    for item in args.set or []:
+        if "=" not in item:
+            raise InputError(f"--set {item!r}: expected KEY=VALUE, e.g. --set indexing.scheme=none")
+        k, v = item.split("=", 1)
+        overrides[k.strip()] = _toml_value(v.strip(), f"--set {k.strip()}")
+    if args.hours is not None:
+        overrides["duration"] = f"{args.hours} h"
+    if overrides:
+        scn = scn.with_overrides(overrides)
+    specs = list(scn.runs())
+    if args.variant is not None:
+        if not 0 <= args.variant < len(specs):
+            raise InputError(f"--variant {args.variant}: the scenario has {len(specs)} variant(s), "
+                             f"0 to {len(specs) - 1}")
+        specs = [specs[args.variant]]
+    result = []
+    for spec in specs:
+        _say(args, f"pyins budget {scn.name} [{spec.label}], {spec.duration_ticks / _TICKS_PER_HOUR:g} h"
+                   + (", every source alone too" if args.check else ""))
+        rows, budget = analysis.run_budget(spec, check=args.check)
+        for r in rows:
+            line = (f"  {r['source']:19s} model N {r['model_north_m'] / NMI_TO_M:+8.3f}  "
+                    f"E {r['model_east_m'] / NMI_TO_M:+8.3f}  final {r['model_final_m'] / NMI_TO_M:7.3f} nmi")
+            if "fil_final_m" in r:
+                line += (f"   FIL N {r['fil_north_m'] / NMI_TO_M:+8.3f}  E {r['fil_east_m'] / NMI_TO_M:+8.3f}"
+                         f"  final {r['fil_final_m'] / NMI_TO_M:7.3f} nmi  rel. diff. "
+                         f"{analysis.budget_verdict(r)[1]}")
+            _say(args, line)
+        result.append(dict(label=spec.label, rows=rows,
+                           eps_n_mean_rad_s={n: budget.eps_n_mean[i].tolist() for i, n in enumerate(budget.names)}))
+    _emit_json(args, dict(scenario=scn.name, variants=result))
+    return EXIT_OK
+
+
 EXAMPLES = {
     "run": "examples:\n  pyins run seed003\n  pyins run my_ship.toml --out runs/my_ship\n"
            "  pyins run seed002_exp1 --hours 6 --set indexing.stop=\"120 s\"\n"
@@ -424,6 +466,8 @@ EXAMPLES = {
     "bench": "example:\n  pyins bench --seconds 5 --json",
     "demo": "example:\n  pyins demo --hours 2 --sensors seed002",
     "version": "example:\n  pyins version",
+    "budget": "examples:\n  pyins budget seed002_exp2 --variant 1   # the traditional two-position scheme\n"
+              "  pyins budget seed003 --hours 6 --check   # every source alone through the firmware too",
 }
 
 
@@ -484,7 +528,8 @@ def build_parser():
                    help="initial attitude [deg] (yaw counter-clockwise = -heading)")
     p.add_argument("--coarse", type=float, help="coarse alignment time [s]")
     p.add_argument("--coarse-method", choices=sorted(scenario.COARSE_METHODS),
-                   help="triad (default; at most 255 output intervals) or fit (no length limit)")
+                   help="triad (default; at most 255 output intervals), fit (no length limit) or eq8 "
+                        "(seed 000 eq. 8 as printed, TRIAD's vectors and limits)")
     p.add_argument("--coarse-every", type=float, help="coarse output interval [s] (default 1 s)")
     p.add_argument("--fine", type=float, help="fine alignment time [s]")
     p.add_argument("--fine-states", type=int, choices=(5, 8, 12),
@@ -530,6 +575,12 @@ def build_parser():
     demo.add_argument("--seed", type=int, default=1, help="noise seed")
     demo.add_argument("--out", default=os.path.join("runs", "demo"), help="output directory")
     cmd("version", "print the package and core versions")
+    p = cmd("budget", "each sensor error's share of a scenario's errors (linear model, one FIL run per variant)")
+    p.add_argument("scenario", help="built-in name (pyins list) or a .toml file")
+    p.add_argument("--hours", type=float, help="override the duration [h]")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario key (repeatable)")
+    p.add_argument("--variant", type=int, help="only this [compare] variant (0, 1, ...; default all)")
+    p.add_argument("--check", action="store_true", help="run every source alone through the firmware too")
     return ap
 
 
@@ -539,7 +590,7 @@ def main(argv=None):
     if getattr(args, "json", False):
         args.quiet = True
     handlers = dict(run=cmd_run, simulate=cmd_simulate, replay=cmd_replay, report=cmd_report,
-                    campaign=cmd_campaign, list=cmd_list, bench=cmd_bench)
+                    campaign=cmd_campaign, list=cmd_list, bench=cmd_bench, budget=cmd_budget)
     try:
         if args.command == "demo":
             if args.sensors not in sim.PRESETS:

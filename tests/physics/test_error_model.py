@@ -11,6 +11,8 @@ The error budget (issue 16, below): the model extended with scale-factor
 and misalignment errors under the run's table angle and ship attitude
 history (pyins.analysis.error_budget), each source against a run of the
 firmware with that error alone, the misalignment-times-tilt case among them."""
+import json
+
 import numpy as np
 import pytest
 
@@ -224,3 +226,19 @@ def test_every_source_alone_and_their_sum(name, scheme):
     parts = [budget.errors(n) for n in budget.names]
     assert np.abs(total.north_m - sum(p.north_m for p in parts)).max() <= 1e-9 * np.abs(total.north_m).max()
     assert np.abs(total.att_n_rad - sum(p.att_n_rad for p in parts)).max() <= 1e-9 * np.abs(total.att_n_rad).max()
+
+
+def test_budget_command(capsys):
+    """`pyins budget SCENARIO --check --json`: one entry per variant, every source and
+    the sum, each checked row within 10 % (or the 1 m floor: budget_verdict); a
+    scenario with an alignment phase is refused with exit code 2 (the model starts
+    navigating at t = 0)."""
+    from pyins.__main__ import main
+    assert main(["budget", "seed003", "--hours", "0.5", "--check", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [v["label"] for v in out["variants"]] == ["no rotation", "single-position fwd/rev (seed 003)"]
+    for v in out["variants"]:
+        assert [r["source"] for r in v["rows"]] == list(analysis.SOURCES) + ["sum"]
+        assert all(analysis.budget_verdict(r)[0] for r in v["rows"])
+    assert main(["budget", "seed000_static", "--hours", "0.1"]) == 2
+    assert "alignment" in capsys.readouterr().err

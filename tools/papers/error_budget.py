@@ -44,20 +44,8 @@ def fmt_nmi(m):
     return f"{m / NMI_TO_M:+.3f}"
 
 
-#: Below this largest horizontal error [m] of the firmware's run a source is not judged
-#: relatively (10 % of almost nothing says nothing): its model must then lie within 10 % of
-#: the floor (0.1 m) over the run. The error-free firmware stays below 0.2 mm in 72 h on
-#: seed 002's swings, so 1 m is far above the firmware's own floor; a uniform accelerometer
-#: scale factor (seed 002: 10 ppm on every axis) acts along the vertical only, which the
-#: firmware holds, and leaves exactly nothing horizontal.
-FLOOR_M = 1.0
-
-
-def judged(r):
-    """(within, cell) of a checked row: rel. diff. <= 10 %, or below FLOOR_M the absolute one."""
-    if r["run_max_m"] >= FLOOR_M:
-        return r["rel_max"] <= 0.10, f"{100 * r['rel_max']:.2f} %"
-    return r["diff_max_m"] <= 0.1 * FLOOR_M, f"({r['diff_max_m']:.2g} m; run < {FLOOR_M:g} m)"
+FLOOR_M = analysis.BUDGET_FLOOR_M     #: below it a run is judged in metres (analysis.budget_verdict)
+judged = analysis.budget_verdict
 
 
 def table_rows(scheme, rows, check):
