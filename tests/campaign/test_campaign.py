@@ -52,10 +52,11 @@ def local_run(tmp_path_factory):
 # ---------------------------------------------------------------------------
 def test_builtin_campaigns_load():
     names = [n for n, _ in campaign.list_builtin()]
-    assert names == ["moored_heave_lever", "seed000_static", "seed000_swing", "seed002_schemes"]
+    assert names == ["moored_heave_lever", "seed000_static", "seed000_swing", "seed002_montecarlo",
+                     "seed002_schemes", "seed003_montecarlo"]
     sizes = {n: len(campaign.load_campaign(n).points) for n in names}
     assert sizes == {"moored_heave_lever": 120, "seed000_static": 30, "seed000_swing": 90,
-                     "seed002_schemes": 40}
+                     "seed002_montecarlo": 800, "seed002_schemes": 40, "seed003_montecarlo": 200}
     swing = campaign.load_campaign("seed000_swing")
     assert len(swing.groups) == 18 and swing.compare == "drop"
     assert campaign.load_campaign("seed002_schemes").base.with_overrides(
