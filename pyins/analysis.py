@@ -240,6 +240,8 @@ def drift_surviving(yaw_p, mask=None):
 SOURCES = ("gyro_bias", "gyro_scale", "gyro_misalignment", "accel_bias", "accel_scale", "accel_misalignment")
 #: The name of the initial-state errors' row.
 INITIAL = "initial"
+#: The name of the noise's row (1 sigma, not a signed share).
+NOISE = "noise"
 
 
 def split_errors(errors, sources=SOURCES):
@@ -550,6 +552,32 @@ def propagate_errors(lat, height, h, eps_n, nabla_n, x0=None, keep_every=1):
     return (keep + 1) * h, out.transpose(1, 0, 2)
 
 
+def noise_covariance(lat, height, h, n_steps, gyro_arw, accel_vrw, keep_every=1):
+    """Covariance of the errors the sensors' white noise drives: an angle
+    random walk ``gyro_arw`` [rad/sqrt(s)] and a velocity random walk
+    ``accel_vrw`` [(m/s)/sqrt(s)], the same on every axis of a triad, so that
+    C_p^n q C_n^p = q I whatever the attitude history (the plant draws them
+    so: pyins.sim.sensors). Stepped with the model of `propagate_errors`:
+    P <- Phi P Phi^T + Gamma (Q / h) Gamma^T, the noise's mean over a step
+    having the variance q / h (exact for the integrators, (F h)^2 off
+    elsewhere). Returns (times (N,), P (N, 7, 7)) at every
+    ``keep_every``-th step end; P = 0 at t = 0 (no initial uncertainty)."""
+    f, g_gyro, g_accel = error_matrix(lat, height)
+    phi, gam = discretize(f, np.hstack([g_gyro, g_accel]), h)
+    q = np.diag([gyro_arw ** 2] * 3 + [accel_vrw ** 2] * 3) / h
+    qd = gam @ q @ gam.T
+    keep = np.arange(keep_every - 1, n_steps, keep_every)
+    out = np.empty((len(keep), 7, 7))
+    cov = np.zeros((7, 7))
+    j = 0
+    for k in range(n_steps):
+        cov = phi @ cov @ phi.T + qd
+        if j < len(keep) and k == keep[j]:
+            out[j] = cov
+            j += 1
+    return (keep + 1) * h, out
+
+
 @dataclass
 class ErrorBudget:
     """Each source's contribution to the errors of a run (linear model)."""
@@ -560,6 +588,7 @@ class ErrorBudget:
     height: float
     eps_n_mean: np.ndarray      #: (S, 3) each source's gyro error in n over the run, mean [rad/s]
     nabla_n_mean: np.ndarray    #: (S, 3) the accelerometers', mean [m/s^2]
+    noise_cov: np.ndarray = None  #: (N, 7, 7) covariance the sensors' noise drives (None: no noise)
 
     def errors(self, name=None):
         """StaticErrors of one source (None: the sum of all of them), signed
@@ -571,9 +600,32 @@ class ErrorBudget:
         return StaticErrors(time_s=self.time_s, att_n_rad=x[:, :3], vel_n_mps=x[:, 3:5], north_m=north,
                             east_m=east, horizontal_m=np.hypot(north, east))
 
+    def position_scale(self):
+        """(north, east) metres per radian of (dL, dlambda)."""
+        rm, rn = earth.principal_radii(np.sin(self.lat))
+        return rm + self.height, (rn + self.height) * np.cos(self.lat)
+
+    def noise(self):
+        """The noise's 1 sigma of every error (a StaticErrors of standard
+        deviations; horizontal_m = sqrt(sigma_N^2 + sigma_E^2), the RMS of the
+        horizontal error), or None without noise."""
+        if self.noise_cov is None:
+            return None
+        sd = np.sqrt(np.diagonal(self.noise_cov, axis1=1, axis2=2))
+        kn, ke = self.position_scale()
+        north, east = sd[:, 5] * kn, sd[:, 6] * ke
+        return StaticErrors(time_s=self.time_s, att_n_rad=sd[:, :3], vel_n_mps=sd[:, 3:5], north_m=north,
+                            east_m=east, horizontal_m=np.hypot(north, east))
+
+    def noise_position_cov(self):
+        """(N, 2, 2) covariance of the (north, east) error [m^2] the noise drives."""
+        kn, ke = self.position_scale()
+        scale = np.diag([kn, ke])
+        return scale @ self.noise_cov[:, 5:7, 5:7] @ scale
+
 
 def error_budget(motion, result, errors, config=None, nodes=4, kinks=True, from_records=False,
-                 keep_every=1):
+                 keep_every=1, noise=None):
     """The error budget of a closed-loop run: each source's signed
     contribution to the position, velocity and attitude errors over time.
 
@@ -585,8 +637,10 @@ def error_budget(motion, result, errors, config=None, nodes=4, kinks=True, from_
     configuration the run started from (``table_angle_rad``; its initial
     state against the truth is the source "initial", `initial_state_errors`).
     ``from_records``: drive from the firmware's recorded attitude instead of
-    the motion (`error_drive_from_records`). Returns an ErrorBudget whose
-    times are the records' (every ``keep_every``-th).
+    the motion (`error_drive_from_records`). ``noise``: (gyro_arw,
+    accel_vrw) whose 1 sigma to propagate (`noise_covariance`; None: none).
+    Returns an ErrorBudget whose times are the records' (every
+    ``keep_every``-th).
     """
     from pyins.scenario.build import initial_truth
     config = config or {}
@@ -613,9 +667,13 @@ def error_budget(motion, result, errors, config=None, nodes=4, kinks=True, from_
         eps = np.concatenate([eps, np.zeros((1,) + eps.shape[1:])])
         nab = np.concatenate([nab, np.zeros((1,) + nab.shape[1:])])
         x0 = np.vstack([x0, init])
-    times, states = propagate_errors(lat, height, float(t_rec[0]), eps, nab, x0, keep_every)
+    h = float(t_rec[0])
+    times, states = propagate_errors(lat, height, h, eps, nab, x0, keep_every)
+    noise_cov = None
+    if noise is not None and (noise[0] > 0.0 or noise[1] > 0.0):
+        _, noise_cov = noise_covariance(lat, height, h, len(t_rec), noise[0], noise[1], keep_every)
     return ErrorBudget(time_s=times, names=names, states=states, lat=lat, height=height,
-                       eps_n_mean=eps.mean(axis=1), nabla_n_mean=nab.mean(axis=1))
+                       eps_n_mean=eps.mean(axis=1), nabla_n_mean=nab.mean(axis=1), noise_cov=noise_cov)
 
 
 # ---------------------------------------------------------------------------
@@ -634,15 +692,26 @@ def compare_with_run(model, nav):
     """How far the model's position errors (StaticErrors) lie from a run's
     (pyins.metrics.NavErrors) at the model's times: ``rel_max`` = max over
     the run of |(dN, dE) model - run| over the run's largest horizontal
-    error; ``rel_final`` the same at the end over the run's final one."""
+    error; ``rel_final`` the same at the end over the run's final one;
+    ``rel_level``, ``rel_heading``, ``rel_velocity`` the same as rel_max for
+    (phi_E, phi_N), phi_U and (dv_E, dv_N)."""
     idx = np.searchsorted(nav.time_s, model.time_s - 1e-6)
     if np.any(idx >= len(nav.time_s)) or np.any(np.abs(nav.time_s[idx] - model.time_s) > 1e-6):
         raise ValueError("compare_with_run: the model's times are not among the run's records")
     diff = np.hypot(model.north_m - nav.north_m[idx], model.east_m - nav.east_m[idx])
     run_h = np.hypot(nav.north_m, nav.east_m)
+
+    def rel(d, r):
+        """max |model - run| over max |run| of one quantity (rows: its components)."""
+        top = np.linalg.norm(r, axis=1).max()
+        return float(np.linalg.norm(d, axis=1).max() / top) if top > 0 else float("inf")
+    att, vel = nav.att_n_rad[idx], nav.vel_n_mps[idx, :2]
     return dict(rel_max=float(diff.max() / run_h.max()) if run_h.max() > 0 else float("inf"),
                 rel_final=float(diff[-1] / run_h[-1]) if run_h[-1] > 0 else float("inf"),
-                diff_max_m=float(diff.max()), run_max_m=float(run_h.max()), run_final_m=float(run_h[-1]))
+                diff_max_m=float(diff.max()), run_max_m=float(run_h.max()), run_final_m=float(run_h[-1]),
+                rel_level=rel(model.att_n_rad[:, :2] - att[:, :2], att[:, :2]),
+                rel_heading=rel(model.att_n_rad[:, 2:] - att[:, 2:], att[:, 2:]),
+                rel_velocity=rel(model.vel_n_mps - vel, vel))
 
 
 #: Below this largest horizontal error [m] of the firmware's run a source is not
@@ -689,7 +758,9 @@ def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=N
     navigation from t = 0 with the vertical channel held, on a ship at a
     fixed position. Returns (rows, budget): one dict per source and one
     "sum" row (final north/east [m], final and max horizontal [m], and with
-    ``check`` the run's and the relative differences).
+    ``check`` the run's and the relative differences); with noise in
+    ``spec.errors`` a last row "noise": its 1 sigma (north, east, horizontal
+    RMS; ``one_sigma`` True), which no single run is checked against.
     """
     from pyins import fil, metrics
     from pyins.sim.sensors import SensorErrors
@@ -707,7 +778,8 @@ def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=N
             progress()
         return res
     base = run(errs, cfg)
-    budget = error_budget(spec.motion, base, errs, cfg, keep_every=keep_every)
+    budget = error_budget(spec.motion, base, errs, cfg, keep_every=keep_every,
+                          noise=(spec.errors.gyro_arw, spec.errors.accel_vrw))
     rows = []
     sources = split_errors(errs)
     clean = {k: v for k, v in cfg.items() if k not in _INITIAL_FIELDS}
@@ -727,4 +799,7 @@ def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=N
     total = budget.errors()
     nav = metrics.nav_errors(base)
     rows.append(_row("sum", total, nav, compare_with_run(total, nav)))
+    sd = budget.noise()
+    if sd is not None:      # not a signed share: the 1 sigma of one noise draw's (ARW, VRW)
+        rows.append(dict(_row(NOISE, sd), one_sigma=True))
     return rows, budget

@@ -13,7 +13,8 @@ none / single-position, 24 h): one closed-loop run with all the scenario's
 deterministic errors (noise left out) and its initial errors gives the
 table's history; the model splits its error by source (gyro bias, scale
 factor, misalignment; accelerometer bias, scale factor, misalignment;
-initial state). With the check (the default) every source also runs alone
+initial state), and gives the 1 sigma of the sensors' noise (ARW, VRW) by
+covariance. With the check (the default) every source also runs alone
 through the firmware and the model, driven by that run's own table
 history, is held to it: "rel. diff." is the largest distance over the run
 between the model's and the run's (north, east) errors over the run's
@@ -37,7 +38,8 @@ from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
 LABELS = {"gyro_bias": "gyro bias", "gyro_scale": "gyro scale factor",
           "gyro_misalignment": "gyro misalignment", "accel_bias": "accel. bias",
           "accel_scale": "accel. scale factor", "accel_misalignment": "accel. misalignment",
-          "initial": "initial errors", "sum": "sum (all together)"}
+          "initial": "initial errors", "sum": "sum (all together)",
+          "noise": "noise, 1 sigma (ARW, VRW)"}
 
 
 def fmt_nmi(m):
@@ -51,15 +53,20 @@ judged = analysis.budget_verdict
 def table_rows(scheme, rows, check):
     out = []
     for r in rows:
-        cells = [scheme, LABELS.get(r["source"], r["source"]),
-                 f"{fmt_nmi(r['model_north_m'])} / {fmt_nmi(r['model_east_m'])}",
+        if r.get("one_sigma"):           # the noise: 1 sigma of north and east, RMS of the horizontal
+            ne = f"+-{r['model_north_m'] / NMI_TO_M:.3f} / +-{r['model_east_m'] / NMI_TO_M:.3f}"
+        else:
+            ne = f"{fmt_nmi(r['model_north_m'])} / {fmt_nmi(r['model_east_m'])}"
+        cells = [scheme, LABELS.get(r["source"], r["source"]), ne,
                  f"{r['model_final_m'] / NMI_TO_M:.3f}", f"{r['model_max_m'] / NMI_TO_M:.3f}"]
         if "fil_north_m" in r:
+            other = (f"{100 * max(r['rel_level'], r['rel_heading']):.2f} % / {100 * r['rel_velocity']:.2f} %"
+                     if r["run_max_m"] >= FLOOR_M else "")
             cells += [f"{fmt_nmi(r['fil_north_m'])} / {fmt_nmi(r['fil_east_m'])}",
                       f"{r['fil_final_m'] / NMI_TO_M:.3f}", f"{r['fil_max_m'] / NMI_TO_M:.3f}",
-                      judged(r)[1]]
+                      judged(r)[1], other]
         elif check:
-            cells += ["", "", "", ""]
+            cells += ["", "", "", "", ""]
         out.append("| " + " | ".join(cells) + " |")
     return out
 
@@ -71,8 +78,8 @@ def write_tables(out, out_dir):
     head = ["| scheme | source | model final N / E (nmi) | model final | model max |"]
     rule = "|---|---|---|---|---|"
     if check:
-        head[0] += " FIL final N / E (nmi) | FIL final | FIL max | rel. diff. |"
-        rule += "---|---|---|---|"
+        head[0] += " FIL final N / E (nmi) | FIL final | FIL max | rel. diff. | attitude / velocity |"
+        rule += "---|---|---|---|---|"
     per = {}
     level = ["| experiment | deck | scheme | model final (nmi) | FIL final (nmi) | rel. diff. | "
              "mean eps_U of the misalignment (deg/h) |", "|---|---|---|---|---|---|---|"]
@@ -88,7 +95,11 @@ def write_tables(out, out_dir):
                          f"{100 * mis['rel_max']:.2f} % | {run['eps_u_mean_dph']['gyro_misalignment']:+.5f} |")
     note = ("Final north / east error (signed, nmi), final and maximum horizontal error (nmi); "
             "rel. diff. = max over the run of |model - FIL| (north, east) / max FIL horizontal error "
-            f"(a run below {FLOOR_M:g} m: the absolute difference, within 10 % of {FLOOR_M:g} m).")
+            f"(a run below {FLOOR_M:g} m: the absolute difference, within 10 % of {FLOOR_M:g} m); "
+            "attitude / velocity: the same measure for the attitude error (the larger of level and "
+            "heading) and the horizontal velocity error. The noise row is the model's 1 sigma of one "
+            "draw of the sensors' noise (north, east; final and max horizontal: RMS), not a signed "
+            "share, and is not in the sum.")
     text = ["# Error budget by source: linear model and firmware in the loop", "", note, ""]
     for name, rows in per.items():
         hours = next(r["hours"] for r in out["runs"] if r["scenario"] == name)
