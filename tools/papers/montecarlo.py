@@ -189,6 +189,24 @@ def paper_figures(key):
     return out
 
 
+def _figure(papers, scheme, period, metric):
+    """The paper's figure for ``metric``; seed 002 prints one figure per scheme
+    without saying whether it is the final or the maximum error: it is placed
+    in both distributions."""
+    figs = papers.get((scheme, period), {})
+    if metric in figs:
+        return figs[metric]
+    if metric == "horizontal_error_max":
+        return figs.get("horizontal_error_final")
+    return None
+
+
+def up_gyro_dph(key, draw):
+    """The drawn up-gyro (z) drift of ``draw`` [deg/h]."""
+    from pyins.sim import sensors
+    return float(sensors.random_constant_values(key, draw)["gyro_bias"][0][2])
+
+
 def statistics(key, result):
     """The tables of the report, in data form."""
     labels = {"indexing.scheme": dict(zip(*[result["campaign"]["grid"]["indexing.scheme"],
@@ -204,7 +222,7 @@ def statistics(key, result):
             v = np.array([d[r] for r in sorted(draws)]) / scale
             if v.size == 0:
                 continue
-            fig = papers.get((scheme, period), {}).get(metric)
+            fig = _figure(papers, scheme, period, metric)
             p5, p50, p95 = np.percentile(v, [5, 50, 95])
             row = {"scheme": scheme, "label": labels["indexing.scheme"][scheme], "period": period,
                    "experiment": SEED002_EXPERIMENTS[period][0] if period else "",
@@ -213,6 +231,10 @@ def statistics(key, result):
             if fig is not None:
                 x = fig["value_si"] / scale
                 row.update(paper=float(x), relation=fig["relation"], paper_percentile=percentile_of(v, x))
+                # the up-gyro drift of the draws below the paper's figure, against all draws'
+                eps = np.abs([up_gyro_dph(key, r) for r in sorted(draws)])
+                row.update(eps_u_all_dph=float(np.median(eps)),
+                           eps_u_below_dph=float(np.median(eps[v < x])) if np.any(v < x) else None)
             rows.append(row)
         for better, worse in PAIRS[key]:
             for period in sorted({k[1] for k in data}, key=lambda p: (p is None, p)):
@@ -243,7 +265,7 @@ def histograms(key, result, stats, path):
     papers = paper_figures(key)
     data = per_draw(result, metric)
     periods = sorted({k[1] for k in data}, key=lambda p: (p is None, p), reverse=True)
-    schemes = list(result["campaign"]["grid"]["indexing.scheme"])
+    schemes = [s for s in result["campaign"]["grid"]["indexing.scheme"] if any(k[0] == s for k in data)]
     fig, axes = plt.subplots(len(periods), len(schemes), figsize=(3.2 * len(schemes), 2.8 * len(periods)),
                              squeeze=False)
     for i, period in enumerate(periods):
@@ -254,7 +276,7 @@ def histograms(key, result, stats, path):
             if v.size:
                 ax.hist(v, bins=20, color="0.6", edgecolor="0.3")
                 ax.axvline(np.median(v), color="k", lw=1, label=f"median {np.median(v):.2f}")
-            f = papers.get((scheme, period), {}).get(metric)
+            f = _figure(papers, scheme, period, metric)
             if f is not None:
                 x = f["value_si"] / scale
                 pct = percentile_of(v, x) if v.size else float("nan")
@@ -275,17 +297,21 @@ def histograms(key, result, stats, path):
 def _fmt_rows(rows, key):
     out = []
     if key == "seed002":
-        out.append("| experiment | scheme | metric | draws | median | 5-95 % | paper | paper's percentile |")
-        out.append("|---|---|---|---|---|---|---|---|")
+        out.append("| experiment | scheme | metric | draws | median | 5-95 % | paper | paper's percentile | "
+                   "median abs(eps_U) below the paper's figure (deg/h) |")
+        out.append("|---|---|---|---|---|---|---|---|---|")
     else:
-        out.append("| scheme | metric | draws | median | 5-95 % | paper | paper's percentile |")
-        out.append("|---|---|---|---|---|---|---|")
+        out.append("| scheme | metric | draws | median | 5-95 % | paper | paper's percentile | "
+                   "median abs(eps_U) below the paper's figure (deg/h) |")
+        out.append("|---|---|---|---|---|---|---|---|")
     for r in rows:
         paper = (f"{'' if r.get('relation') in (None, '=') else r['relation'] + ' '}{r['paper']:g}"
                  if "paper" in r else "")
         pct = f"{r['paper_percentile']:.0f}" if "paper" in r else ""
         cells = [r["label"], r["metric"].replace("_", " "), str(r["n"]),
-                 f"{r['median']:.3g} {r['unit']}", f"{r['p5']:.3g} - {r['p95']:.3g}", paper, pct]
+                 f"{r['median']:.3g} {r['unit']}", f"{r['p5']:.3g} - {r['p95']:.3g}", paper, pct,
+                 "" if r.get("eps_u_below_dph") is None else
+                 f"{r['eps_u_below_dph']:.4f} (all draws {r['eps_u_all_dph']:.4f})"]
         if key == "seed002":
             cells.insert(0, r["experiment"])
         out.append("| " + " | ".join(cells) + " |")
@@ -332,7 +358,25 @@ def report(keys, out_root, report_dir):
                *_fmt_pairs(stats["pairs"], stats["labels"]), "", timing_line(key, out), ""]
     with open(os.path.join(report_dir, "montecarlo.json"), "w") as f:
         json.dump(blob, f, indent=1, allow_nan=True)
-    return "\n".join(md)
+    text = "\n".join(md)
+    _fill_markdown(os.path.join(report_dir, "montecarlo.md"), keys, text)
+    return text
+
+
+def _fill_markdown(path, keys, text):
+    """Put the tables between montecarlo.md's markers (its prose is written by hand)."""
+    begin, end = "<!-- montecarlo tables: begin (tools/papers/montecarlo.py writes this part) -->", \
+        "<!-- montecarlo tables: end -->"
+    if sorted(keys) != sorted(CAMPAIGNS) or not os.path.exists(path):
+        return
+    with open(path, encoding="utf-8") as f:
+        doc = f.read()
+    if begin not in doc or end not in doc:
+        return
+    head, rest = doc.split(begin, 1)
+    tail = rest.split(end, 1)[1]
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(f"{head}{begin}\n\n{text}\n{end}{tail}")
 
 
 # ---------------------------------------------------------------------------
@@ -352,10 +396,17 @@ def comparable(result):
     return {k: v for k, v in result.items() if k != "execution"}
 
 
-def dask_identity(out, draws=3, hours=1, workers=2, processes=True):
-    """Run `small_campaign` locally and on a LocalCluster; returns (same?, local, dask, seconds)."""
+def dask_identity(out, draws=3, hours=1, workers=2, processes=True, camp=None, local_runs=None):
+    """Run `small_campaign` (or ``camp``) locally and on a LocalCluster; returns
+    (same?, local, dask, seconds). ``local_runs``: an existing runs/ directory
+    the local side reads (linked, so what is complete there is not rerun)."""
     from distributed import LocalCluster
-    camp = small_campaign(draws, hours)
+    camp = camp or small_campaign(draws, hours)
+    if local_runs:
+        os.makedirs(os.path.join(out, "local"), exist_ok=True)
+        link = os.path.join(out, "local", "runs")
+        if not os.path.exists(link):
+            os.symlink(os.path.abspath(local_runs), link)
     t0 = time.perf_counter()
     local = campaign.run_campaign(camp, os.path.join(out, "local"), workers=workers, plots=False)
     t1 = time.perf_counter()
@@ -380,7 +431,10 @@ def main(argv=None):
     ap.add_argument("--schemes", default=None,
                     help="only these indexing.scheme values, comma separated (default: the campaign's)")
     ap.add_argument("--report-only", action="store_true")
-    ap.add_argument("--dask-identity", action="store_true")
+    ap.add_argument("--dask-identity", action="store_true",
+                    help="3 draws x 2 schemes x 1 h locally and on a Dask LocalCluster; with --dask-draws N "
+                         "the first N draws of seed003_montecarlo on Dask against the local runs in --out")
+    ap.add_argument("--dask-draws", type=int, default=0)
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     keys = a.seeds or list(CAMPAIGNS)
@@ -388,8 +442,15 @@ def main(argv=None):
         if key not in CAMPAIGNS:
             ap.error(f"unknown {key!r}: choose from {', '.join(CAMPAIGNS)}")
     if a.dask_identity:
-        same, local, dask, (tl, td) = dask_identity(os.path.join(a.out, "dask_identity"))
-        print(f"local pool {local['execution']['computed']} runs in {tl:.1f} s "
+        if a.dask_draws:
+            camp = first_draws(campaign.load_campaign(CAMPAIGNS["seed003"]), a.dask_draws)
+            same, local, dask, (tl, td) = dask_identity(
+                os.path.join(a.out, f"dask_identity_seed003_{a.dask_draws}"), camp=camp,
+                local_runs=os.path.join(a.out, "seed003", "runs"))
+        else:
+            same, local, dask, (tl, td) = dask_identity(os.path.join(a.out, "dask_identity"))
+        print(f"local pool {local['execution']['computed']} runs computed "
+              f"({local['execution']['skipped']} found complete) in {tl:.1f} s "
               f"({local['execution']['scheduler']}); Dask {dask['execution']['computed']} runs in "
               f"{td:.1f} s ({dask['execution']['scheduler']})")
         print("campaign.json without 'execution':", "IDENTICAL" if same else "DIFFERENT")
