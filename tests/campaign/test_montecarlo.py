@@ -197,3 +197,32 @@ def test_first_draws_shares_the_runs():
     whole = {(p.run, p.values["indexing.scheme"], p.values["motion.period"]): p.digest for p in camp.points}
     for p in sub.points:
         assert whole[(p.run, p.values["indexing.scheme"], p.values["motion.period"])] == p.digest
+
+
+def test_statistics_pair_the_draws():
+    """statistics() on a made-up seed 002 result: 10 draws, flexible smaller
+    than traditional in draws 0-6 of exp. 1 (P = 0.7, paired by draw, not by
+    rank); the paper's 2.97 nmi (flexible, exp. 1) sits above 3 of the
+    flexible draws' 1..10 nmi (30th percentile); a draw missing from one
+    scheme drops out of the pair only."""
+    mc = _driver()
+    nmi = 1852.0
+    points = []
+    for d in range(10):
+        trad = (d + 1) * nmi
+        flex = (d + 0.5) * nmi if d < 7 else (d + 1.5) * nmi     # 1..10 nmi over the draws, shifted
+        for scheme, h in (("two_position", trad), ("flexible", flex)):
+            points.append({"values": {"indexing.scheme": scheme, "motion.period": "120 s"}, "run": d,
+                           "metrics": {"": {"horizontal_error_final_m": h, "horizontal_error_max_m": h}}})
+    points.append({"values": {"indexing.scheme": "two_position", "motion.period": "120 s"}, "run": 10,
+                   "metrics": {"": {"horizontal_error_final_m": nmi, "horizontal_error_max_m": nmi}}})
+    result = {"points": points, "campaign": {"grid": {"indexing.scheme": ["two_position", "flexible"]},
+                                             "labels": {"indexing.scheme": ["trad", "flex"]}}}
+    st = mc.statistics("seed002", result)
+    pair = next(p for p in st["pairs"] if p["metric"] == "horizontal_error_final")
+    assert (pair["better"], pair["worse"], pair["n"], pair["wins"]) == ("flexible", "two_position", 10, 7)
+    assert pair["ci90"] == pytest.approx(list(mc.clopper_pearson(7, 10)))
+    flex = next(r for r in st["rows"] if r["scheme"] == "flexible" and r["metric"] == "horizontal_error_final")
+    assert flex["paper"] == pytest.approx(2.97, abs=1e-9) and flex["paper_percentile"] == 30.0
+    trad = next(r for r in st["rows"] if r["scheme"] == "two_position" and r["metric"] == "horizontal_error_final")
+    assert trad["n"] == 11 and trad["paper"] == pytest.approx(3.70, abs=1e-9)

@@ -219,7 +219,8 @@ def statistics(key, result):
         draws = set.intersection(*(set(d) for d in data.values())) if data else set()
         complete_draws = draws if complete_draws is None else complete_draws & draws
         for (scheme, period), d in data.items():
-            v = np.array([d[r] for r in sorted(draws)]) / scale
+            mine = sorted(d)                 # every complete draw of this group
+            v = np.array([d[r] for r in mine]) / scale
             if v.size == 0:
                 continue
             fig = _figure(papers, scheme, period, metric)
@@ -232,7 +233,7 @@ def statistics(key, result):
                 x = fig["value_si"] / scale
                 row.update(paper=float(x), relation=fig["relation"], paper_percentile=percentile_of(v, x))
                 # the up-gyro drift of the draws below the paper's figure, against all draws'
-                eps = np.abs([up_gyro_dph(key, r) for r in sorted(draws)])
+                eps = np.abs([up_gyro_dph(key, r) for r in mine])
                 row.update(eps_u_all_dph=float(np.median(eps)),
                            eps_u_below_dph=float(np.median(eps[v < x])) if np.any(v < x) else None)
             rows.append(row)
@@ -251,6 +252,7 @@ def statistics(key, result):
                               "p": wins / len(common) if common else float("nan"), "ci90": [lo, hi],
                               "median_ratio": float(np.median(ratio)) if common else float("nan")})
     return {"rows": rows, "pairs": pairs, "draws": len(complete_draws or ()),
+            "draws_max": max((r["n"] for r in rows), default=0),
             "labels": labels["indexing.scheme"]}
 
 
@@ -288,7 +290,7 @@ def histograms(key, result, stats, path):
             ax.set_title(title, fontsize=9)
             ax.set_xlabel(f"{metric.replace('_', ' ')} [{unit}]", fontsize=8)
             ax.legend(fontsize=7)
-    fig.suptitle(f"{key}: {stats['draws']} draws of the random constants", fontsize=10)
+    fig.suptitle(f"{key}: draws of the random constants (up to {stats['draws_max']} per scheme)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -328,7 +330,12 @@ def _fmt_pairs(pairs, labels):
     return out
 
 
-def timing_line(key, out):
+def timing_line(key, out, runs_timing=None):
+    if runs_timing and runs_timing["complete"]:
+        r = runs_timing
+        return (f"{key}: {r['complete']} runs complete; from the first run's start to the last run's end "
+                f"{r['span_s'] / 60:.1f} min ({r['complete'] / r['span_s']:.3f} runs/s, pauses between "
+                f"sessions included); {r['run_s'] / r['complete']:.2f} s per run in a worker")
     t = read_timing(out)
     if not t.get("computed"):
         return f"{key}: no runs computed yet"
@@ -338,24 +345,46 @@ def timing_line(key, out):
             f"{len(t['sessions'])} session(s): {rps:.3f} runs/s; {per:.2f} s per run in a worker")
 
 
+def collect(camp, out):
+    """campaign.json's points (values, run, metrics in SI) read from the run
+    directories of ``out`` directly: every complete run of the whole campaign,
+    whatever block or session made it (campaign.json holds only the last block,
+    and no metrics while a block runs)."""
+    from pyins.campaign.aggregate import read_summary
+    from pyins.metrics import si_name
+    points, run_s, first, last = [], [], [], []
+    for p in camp.points:
+        s = read_summary(os.path.join(out, p.dir))
+        ok = s is not None and s.get("complete") is True and s.get("digest") == p.digest
+        metrics = {"": {si_name(k): x for k, x in s["variants"][0]["metrics"].items()}} if ok else None
+        points.append({"index": p.index, "values": p.values, "run": p.run, "seed": p.seed,
+                       "digest": p.digest, "metrics": metrics})
+        if ok:
+            run_s.append(s["variants"][0].get("wall_s") or 0.0)
+            first.append(os.path.getmtime(os.path.join(out, p.dir, "point.json")))
+            last.append(os.path.getmtime(os.path.join(out, p.dir, "summary.json")))
+    span = (max(last) - min(first)) if last else 0.0
+    return {"campaign": camp.describe(), "points": points,
+            "runs_timing": {"complete": len(run_s), "run_s": float(sum(run_s)), "span_s": span}}
+
+
 def report(keys, out_root, report_dir):
     """Write montecarlo.json and the histograms into ``report_dir``; returns the tables as Markdown."""
     os.makedirs(report_dir, exist_ok=True)
     blob, md = {}, []
     for key in keys:
         out = os.path.join(out_root, key)
-        try:
-            with open(os.path.join(out, "campaign.json")) as f:
-                result = json.load(f)
-        except OSError:
-            md.append(f"{key}: no campaign.json in {out}")
+        result = collect(campaign.load_campaign(CAMPAIGNS[key]), out)
+        if not any(p["metrics"] for p in result["points"]):
+            md.append(f"{key}: no complete run in {out}")
             continue
         stats = statistics(key, result)
         histograms(key, result, stats, os.path.join(report_dir, f"montecarlo_{key}.png"))
-        blob[key] = dict(stats, timing=read_timing(out), campaign=CAMPAIGNS[key],
-                         campaign_digest=result["campaign"]["digest"])
-        md += [f"### {key}: {stats['draws']} draws", "", *_fmt_rows(stats["rows"], key), "",
-               *_fmt_pairs(stats["pairs"], stats["labels"]), "", timing_line(key, out), ""]
+        blob[key] = dict(stats, timing=read_timing(out), runs_timing=result["runs_timing"],
+                         campaign=CAMPAIGNS[key], campaign_digest=result["campaign"]["digest"])
+        md += [f"### {key}: {stats['draws_max']} draws (every group: {stats['draws']})", "",
+               *_fmt_rows(stats["rows"], key), "", *_fmt_pairs(stats["pairs"], stats["labels"]), "",
+               timing_line(key, out, result["runs_timing"]), ""]
     with open(os.path.join(report_dir, "montecarlo.json"), "w") as f:
         json.dump(blob, f, indent=1, allow_nan=True)
     text = "\n".join(md)
@@ -462,8 +491,6 @@ def main(argv=None):
             run_seed(key, a.draws, a.block, os.path.join(a.out, key), a.workers, a.scheduler, a.quiet,
                      schemes)
     print(report(keys, a.out, a.report))
-    for key in keys:
-        print(timing_line(key, os.path.join(a.out, key)))
     return 0
 
 
