@@ -528,7 +528,8 @@ def build_parser():
                    help="initial attitude [deg] (yaw counter-clockwise = -heading)")
     p.add_argument("--coarse", type=float, help="coarse alignment time [s]")
     p.add_argument("--coarse-method", choices=sorted(scenario.COARSE_METHODS),
-                   help="triad (default; at most 255 output intervals) or fit (no length limit)")
+                   help="triad (default; at most 255 output intervals), fit (no length limit) or eq8 "
+                        "(seed 000 eq. 8 as printed, TRIAD's vectors and limits)")
     p.add_argument("--coarse-every", type=float, help="coarse output interval [s] (default 1 s)")
     p.add_argument("--fine", type=float, help="fine alignment time [s]")
     p.add_argument("--fine-states", type=int, choices=(5, 8, 12),

@@ -45,7 +45,7 @@ def explain(status, cfg, names=None):
     r = resolved(cfg)
     hz = r["tick_hz"] if r["tick_hz"] > 0 else fw_config.DEFAULT_TICK_HZ
     every, first = r["coarse_output_every_ticks"], r["coarse_first_output_ticks"]
-    triad = r["coarse_method"] == abi.PYINS_COARSE_TRIAD
+    triad = r["coarse_method"] != abi.PYINS_COARSE_FIT     # TRIAD or eq. 8: the same history
     if status == abi.PYINS_E_CONFIG_RATE:
         return (f"{n('tick_hz')}: {cfg.get('tick_hz')} Hz is outside the rates the firmware steps at "
                 f"(1 to {fw_config.MAX_TICK_HZ} Hz)")
@@ -81,7 +81,7 @@ def explain(status, cfg, names=None):
                 f"ratio {r['coarse_ratio']:g} leaves less than one output interval ({_s(every, hz)})")
     if status == abi.PYINS_E_CONFIG_ALIGN_LONG:
         longest = (coarse_align.HIST_LEN - 1) * every
-        return (f"{n('coarse_ticks')}: a TRIAD coarse alignment keeps {coarse_align.HIST_LEN - 1} output "
+        return (f"{n('coarse_ticks')}: a TRIAD (or eq. 8) coarse alignment keeps {coarse_align.HIST_LEN - 1} output "
                 f"intervals, so with a {_s(every, hz)} interval it lasts at most {_s(longest, hz)}, not "
                 f"{_s(r['coarse_ticks'], hz)}: a {_s(2 * every, hz)} interval "
                 f"({n('coarse_output_every_ticks')}) allows {_s(2 * longest, hz)}, and "
@@ -94,7 +94,7 @@ def explain(status, cfg, names=None):
                 f"({n('fine_gyro_arw')}, {n('fine_accel_vrw')}, {n('fine_sigma0_att_rad')}, ...) must "
                 "be positive and finite")
     if status == abi.PYINS_E_CONFIG_COARSE_METHOD:
-        return f"{n('coarse_method')}: triad or fit"
+        return f"{n('coarse_method')}: triad, fit or eq8"
     return f"the firmware refuses the configuration: {native.status_str(status)}"
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 12)
+EXPECTED_ABI = (0, 13)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")

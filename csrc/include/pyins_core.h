@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 12
+#define PYINS_ABI_VERSION_MINOR 13
 
 #ifdef __cplusplus
 extern "C" {
@@ -132,10 +132,12 @@ typedef struct pyins_index_step {
 enum pyins_coarse_method {
     PYINS_COARSE_TRIAD = 0,       /* seed 000: the velocity integrals at t_k1 = r t_k2 and t_k2 (TRIAD);
                                      assumes the IMU at rest at t0 and no linear motion */
-    PYINS_COARSE_FIT = 1          /* moving base: the integrals of the velocity integrals weighted by two
+    PYINS_COARSE_FIT = 1,         /* moving base: the integrals of the velocity integrals weighted by two
                                      smooth functions that ignore an unknown initial velocity and
                                      position offset and suppress bounded wave motion
                                      (docs/concepts.md, "Alignment on a moving base") */
+    PYINS_COARSE_EQ8 = 2          /* seed 000 eq. 8 as printed: the same vectors as TRIAD, C_ib0^i =
+                                     A^-1 B, not orthonormalised (docs/core.md) */
 };
 
 /* How the fine alignment uses its attitude estimate. */
@@ -262,7 +264,7 @@ typedef struct pyins_config {
      * and the initial state above are those of the ship's reference point. */
     double lever_b_m[3];          /* reference point -> turntable centre, in b [m]; |r| <= 100 m */
     double lever_p_m[3];          /* turntable centre -> accelerometer triad, in p [m]; |r| <= 100 m */
-    int32_t coarse_method;        /* enum pyins_coarse_method; 0 = seed 000's TRIAD */
+    int32_t coarse_method;        /* enum pyins_coarse_method; 0 = seed 000's TRIAD, 2 = its eq. 8 */
     int32_t reserved2;            /* padding, ignored; keep 0 */
     /* Integrity tests of the alignment (docs/concepts.md, "Integrity"). */
     int32_t integrity_nis_window; /* fine-alignment updates per NIS window; 0 = 100, -1 = no test */

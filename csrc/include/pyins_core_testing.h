@@ -77,6 +77,9 @@ void pyins_t_coarse_fit_weights(double s, double *phi_a, double *phi_b);
 void pyins_t_coarse_solve_fit(const double *grid, int32_t n, double t_step, double sin_lat,
                               double cos_lat, double gravity, double m[9]);
 double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]);
+/* coarse_align: seed 000 eq. 8 as printed (row-major C_ib0^i) */
+void pyins_t_coarse_solve_eq8(const double vi1[3], const double vi2[3], const double vb1[3],
+                              const double vb2[3], double m[9]);
 
 /* moving_align: n ticks of dv_sf_n (n x 3) and z (n x 2, read at the update
  * ticks); writes x (12) and P (144, row-major); returns the number of

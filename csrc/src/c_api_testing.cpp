@@ -216,6 +216,11 @@ void pyins_t_coarse_solve_fit(const double* grid, int32_t n, double t_step, doub
     put9(pyins::coarse_align::solve_fit(g, k_max, t_step, sin_lat, cos_lat, gravity), m);
 }
 
+void pyins_t_coarse_solve_eq8(const double vi1[3], const double vi2[3], const double vb1[3],
+                              const double vb2[3], double m[9]) {
+    put9(pyins::coarse_align::solve_eq8(v3(vi1), v3(vi2), v3(vb1), v3(vb2)), m);
+}
+
 double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]) {
     return pyins::coarse_align::rotation_sine(m9(a), m9(b));
 }

@@ -39,6 +39,24 @@ Mat3 solve_mat_i_ib0(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Ve
     return ti * tb.transpose();
 }
 
+Mat3 solve_eq8(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Vec3& vb2) {
+    // Seed 000 eq. 8: C_ib0^i = [vi1^T; vi2^T; (vi1 x vi2)^T]^-1 [vb1^T; vb2^T; (vb1 x vb2)^T].
+    // Inverse of rows (a1, a2, a3): columns (a2 x a3, a3 x a1, a1 x a2) / a1.(a2 x a3).
+    const Vec3 a3 = cross(vi1, vi2);
+    const Vec3 c1 = cross(vi2, a3);
+    const Vec3 c2 = cross(a3, vi1);
+    const double det = vi1.dot(c1);
+    Mat3 inv;
+    inv.col(0) = c1 / det;
+    inv.col(1) = c2 / det;
+    inv.col(2) = a3 / det;
+    Mat3 b;
+    b.row(0) = vb1.transpose();
+    b.row(1) = vb2.transpose();
+    b.row(2) = cross(vb1, vb2).transpose();
+    return inv * b;
+}
+
 Vec3 pos_i(double t, double sin_lat, double cos_lat, double gravity) {
     // (1 - cos x) / x^2 and (x - sin x) / x^3, x = w t, by their Taylor
     // series: x < 0.2 rad for any alignment the grid can hold at 10 s
@@ -310,7 +328,11 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
             vb1 = vb1 + a.lever_vel0;
             vb2 = vb2 + a.lever_vel0;
         }
-        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2);
+        if (a.prm.method == static_cast<int32_t>(Method::kEq8)) {
+            a.mat_i_ib0 = solve_eq8(vi1, vi2, vb1, vb2);  // seed 000 eq. 8 as printed
+        } else {
+            a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2);
+        }
         a.solved = true;
         settle(a);
     }
@@ -318,8 +340,13 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
 
 Mat3 mat_n_p(const CoarseAlign& a) {
     const double t = static_cast<double>(a.tick) * a.prm.dt;
-    return mat_n_e(a.prm.sin_lat, a.prm.cos_lat) * mat_e_i(t) * a.mat_i_ib0 *
-           attitude::quat_to_mat(a.quat_ib0_p);
+    const Mat3 m = mat_n_e(a.prm.sin_lat, a.prm.cos_lat) * mat_e_i(t) * a.mat_i_ib0 *
+                   attitude::quat_to_mat(a.quat_ib0_p);
+    if (a.prm.method == static_cast<int32_t>(Method::kEq8)) {
+        // seed 000: eq. 8's matrix into eq. 1, the attitude angles read off its elements
+        return attitude::euler_to_mat(attitude::mat_to_euler(m));
+    }
+    return m;
 }
 
 }  // namespace pyins::coarse_align

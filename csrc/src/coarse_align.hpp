@@ -22,6 +22,21 @@
 //   through the TRIAD (dual-vector) construction, anchored on v(t_k2) (the
 //   longer integral, which averages the swing best); the result is a proper
 //   rotation by construction.
+// - Method EQ8: eq. 8 as printed, C_ib0^i = A^-1 B with the rows of A
+//   v^i(t_k1), v^i(t_k2), v^i(t_k1) x v^i(t_k2) and of B the same in ib0
+//   (same t_k1, same history, same lever velocity as TRIAD). A^-1 is the
+//   adjugate over the determinant, the exact inverse. The specific-force sign
+//   flips the first two rows of A and B together (D A, D B with D =
+//   diag(-1, -1, 1)) and (D A)^-1 D B = A^-1 B: the print's sign does not
+//   matter. The paper substitutes the matrix into eq. 1 without
+//   orthonormalising it, and so does the core: under noise or biases C_ib0^i
+//   is a rotation times a small non-orthogonal, non-unit factor (the two
+//   vectors' errors, unweighted: t_k1's error counts as much as t_k2's). The
+//   attitude is read off eq. 1's product as the paper reads it: its Euler
+//   angles (pitch from C32, roll from C31, C33, yaw from C12, C22), whose
+//   rotation mat_n_p returns (Shepperd's quaternion of the raw product
+//   depends on its branch, i.e. on the heading). The wander test reads the
+//   skew part of R^T C. On error-free data it equals TRIAD's solution.
 // - The v^ib0 history is kept on a grid of output_every ticks in fixed storage
 //   (kHistLen entries, no heap); t_k1 is the grid point nearest r t_k2.
 //
@@ -97,7 +112,7 @@ namespace pyins::coarse_align {
 inline constexpr int kHistLen = 256;
 
 /// How C_ib0^i is solved (enum pyins_coarse_method).
-enum class Method : int32_t { kTriad = 0, kFit = 1 };
+enum class Method : int32_t { kTriad = 0, kFit = 1, kEq8 = 2 };
 
 /// FIT needs this many grid intervals at its first output (a polynomial
 /// weight of degree 7 sampled on fewer points is not orthogonal to 1 and s).
@@ -158,6 +173,9 @@ Mat3 triad(const Vec3& u, const Vec3& w);
 /// C_ib0^i from v^i and v^ib0 at t_k1 (index 1) and t_k2 (index 2).
 Mat3 solve_mat_i_ib0(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Vec3& vb2);
 
+/// C_ib0^i by seed 000 eq. 8 as printed: A^-1 B (not orthonormalised).
+Mat3 solve_eq8(const Vec3& vi1, const Vec3& vi2, const Vec3& vb1, const Vec3& vb2);
+
 /// P^i(t) = integral of v^i: the position integral of the specific force (FIT).
 Vec3 pos_i(double t, double sin_lat, double cos_lat, double gravity);
 
@@ -185,7 +203,8 @@ void init(CoarseAlign& a, const Params& prm);
 /// the end of the tick [m/s] (read only with prm.lever).
 void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p);
 
-/// C_p^n now. Precondition: a.solved.
+/// C_p^n now (eq. 1); for EQ8, whose product is not a rotation, the rotation
+/// of the Euler angles read off it (see the header). Precondition: a.solved.
 Mat3 mat_n_p(const CoarseAlign& a);
 
 }  // namespace pyins::coarse_align

@@ -204,7 +204,7 @@ int config_check(const pyins_config& raw) {
             static_cast<double>(every)) {
             return PYINS_E_CONFIG_ALIGN_EARLY;
         }
-        if (cfg.coarse_method == PYINS_COARSE_TRIAD && cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
+        if (cfg.coarse_method != PYINS_COARSE_FIT && cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
             return PYINS_E_CONFIG_ALIGN_LONG;
         }
     }
@@ -247,7 +247,8 @@ int config_check(const pyins_config& raw) {
             return PYINS_E_CONFIG_LEVER;
         }
     }
-    if (cfg.coarse_method != PYINS_COARSE_TRIAD && cfg.coarse_method != PYINS_COARSE_FIT) {
+    if (cfg.coarse_method != PYINS_COARSE_TRIAD && cfg.coarse_method != PYINS_COARSE_FIT &&
+        cfg.coarse_method != PYINS_COARSE_EQ8) {
         return PYINS_E_CONFIG_COARSE_METHOD;
     }
     if (cfg.coarse_method == PYINS_COARSE_FIT && cfg.coarse_ticks > 0 &&

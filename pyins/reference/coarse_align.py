@@ -1,7 +1,8 @@
 """Inertial-frame coarse alignment (seed 000), for the IMU frame p.
 
 Mirrors ``csrc/src/coarse_align.{hpp,cpp}``; the header explains the method,
-the sign of eq. 5, the TRIAD construction that replaces eq. 8, the lever-arm
+the sign of eq. 5, the TRIAD construction that replaces eq. 8 (and eq. 8 as
+printed, method EQ8), the lever-arm
 velocity it removes and the moving-base method FIT.
 """
 import math
@@ -15,6 +16,7 @@ from .attitude import cross
 HIST_LEN = 256  #: kHistLen
 METHOD_TRIAD = 0       #: Method::kTriad (PYINS_COARSE_TRIAD)
 METHOD_FIT = 1         #: Method::kFit (PYINS_COARSE_FIT)
+METHOD_EQ8 = 2         #: Method::kEq8 (PYINS_COARSE_EQ8)
 FIT_MIN_INTERVALS = 8  #: kFitMinIntervals
 
 
@@ -83,6 +85,21 @@ def solve_mat_i_ib0(vi1, vi2, vb1, vb2):
     ti = triad(vi2, vi1)
     tb = triad(vb2, vb1)
     return ti @ tb.T
+
+
+def solve_eq8(vi1, vi2, vb1, vb2):
+    """C_ib0^i by seed 000 eq. 8 as printed, A^-1 B, not orthonormalised
+    (mirrors solve_eq8: A^-1 as its adjugate over the determinant)."""
+    a3 = cross(vi1, vi2)
+    c1 = cross(vi2, a3)
+    c2 = cross(a3, vi1)
+    # sums of three written out as Eigen's unrolled redux adds them, a0 + (a1 + a2)
+    # (NumPy's @ rounds differently): bit-identical
+    det = vi1[0] * c1[0] + (vi1[1] * c1[1] + vi1[2] * c1[2])
+    inv = np.column_stack([c1 / det, c2 / det, a3 / det])
+    b = np.vstack([vb1, vb2, cross(vb1, vb2)])
+    return np.array([[inv[i, 0] * b[0, j] + (inv[i, 1] * b[1, j] + inv[i, 2] * b[2, j])
+                      for j in range(3)] for i in range(3)])
 
 
 def pos_i(t, sin_lat, cos_lat, gravity):
@@ -262,13 +279,21 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
         if a.prm.lever != 0:
             vb1 = vb1 + a.lever_vel0
             vb2 = vb2 + a.lever_vel0
-        a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2)
+        if a.prm.method == METHOD_EQ8:
+            a.mat_i_ib0 = solve_eq8(vi1, vi2, vb1, vb2)   # seed 000 eq. 8 as printed
+        else:
+            a.mat_i_ib0 = solve_mat_i_ib0(vi1, vi2, vb1, vb2)
         a.solved = True
         settle(a)
 
 
 def mat_n_p(a):
-    """C_p^n now (seed 000 eq. 1). Precondition: a.solved."""
+    """C_p^n now (seed 000 eq. 1); for EQ8 the rotation of the Euler angles read
+    off the product (mirrors mat_n_p). Precondition: a.solved."""
     t = float(a.tick) * a.prm.dt
-    return (mat_n_e(a.prm.sin_lat, a.prm.cos_lat) @ mat_e_i(t) @ a.mat_i_ib0
-            @ attitude.quat_to_mat(a.quat_ib0_p))
+    m = (mat_n_e(a.prm.sin_lat, a.prm.cos_lat) @ mat_e_i(t) @ a.mat_i_ib0
+         @ attitude.quat_to_mat(a.quat_ib0_p))
+    if a.prm.method == METHOD_EQ8:
+        # seed 000: eq. 8's matrix into eq. 1, the attitude angles read off its elements
+        return attitude.euler_to_mat(attitude.mat_to_euler(m))
+    return m

@@ -245,7 +245,7 @@ def config_check(raw):
             return abi.PYINS_E_CONFIG_ALIGN_TICKS
         if cfg["coarse_ratio"] * float(cfg["coarse_first_output_ticks"]) < float(every):
             return abi.PYINS_E_CONFIG_ALIGN_EARLY
-        if (cfg["coarse_method"] == abi.PYINS_COARSE_TRIAD
+        if (cfg["coarse_method"] != abi.PYINS_COARSE_FIT
                 and cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1):
             return abi.PYINS_E_CONFIG_ALIGN_LONG
     if cfg["fine_ticks"] < 0:
@@ -274,7 +274,7 @@ def config_check(raw):
     for r in (cfg["lever_b_m"], cfg["lever_p_m"]):
         if not finite3(r) or r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > MAX_LEVER_M * MAX_LEVER_M:
             return abi.PYINS_E_CONFIG_LEVER
-    if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT):
+    if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_EQ8):
         return abi.PYINS_E_CONFIG_COARSE_METHOD
     if (cfg["coarse_method"] == abi.PYINS_COARSE_FIT and cfg["coarse_ticks"] > 0
             and cfg["coarse_first_output_ticks"] // cfg["coarse_output_every_ticks"]

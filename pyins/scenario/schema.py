@@ -229,7 +229,7 @@ STEP_KEYS = {
 VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
 FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
 FINE_NOISES = {"measured": abi.PYINS_FINE_NOISE_MEASURED, "configured": abi.PYINS_FINE_NOISE_CONFIGURED}
-COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT}
+COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT, "eq8": abi.PYINS_COARSE_EQ8}
 FIRMWARE_KEYS = {
     "initial_attitude": Key("choice", "attitude the firmware starts from: the true one (plus "
                                       "[initial_errors]) or all Euler angles zero", "truth",
@@ -244,8 +244,8 @@ FIRMWARE_KEYS = {
     "coarse_output_every": _time("coarse solution interval (firmware default 1 s)", None,
                                  lo="0.01 s"),
     "coarse_method": Key("choice", "coarse alignment: 'triad' (seed 000, a base that does not move) "
-                                   "or 'fit' (moving base: heave, surge, sway; firmware default "
-                                   "triad)", choices=tuple(COARSE_METHODS)),
+                                   "'fit' (moving base: heave, surge, sway) or 'eq8' (seed 000 "
+                                   "eq. 8 as printed, not orthonormalised; firmware default triad)", choices=tuple(COARSE_METHODS)),
     "lever": Key("choice", "lever arms the firmware is told: 'configured' (the simulated "
                            "motion.lever_b and lever_p) or 'unknown' (zero)", "configured",
                  choices=("configured", "unknown")),

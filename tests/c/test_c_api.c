@@ -229,7 +229,13 @@ int main(void) {
         g.lever_p_m[2] = -100.0;
         check_status(pyins_config_check(&g), PYINS_OK, "sensor offset of exactly 100 m accepted");
     }
-    BAD_CFG(b.coarse_method = 2, PYINS_E_CONFIG_COARSE_METHOD, "unknown coarse method");
+    BAD_CFG(b.coarse_method = 3, PYINS_E_CONFIG_COARSE_METHOD, "unknown coarse method");
+    {
+        pyins_config g;
+        pyins_config_default(&g);
+        g.coarse_method = PYINS_COARSE_EQ8;
+        check_status(pyins_config_check(&g), PYINS_OK, "seed 000 eq. 8 as printed accepted");
+    }
     BAD_CFG(b.coarse_method = -1, PYINS_E_CONFIG_COARSE_METHOD, "negative coarse method");
     BAD_CFG((b.coarse_method = PYINS_COARSE_FIT, b.coarse_ticks = 3000, b.coarse_first_output_ticks = 700),
             PYINS_E_CONFIG_ALIGN_EARLY, "FIT with fewer than 8 grid intervals at its first output");

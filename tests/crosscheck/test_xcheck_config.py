@@ -29,7 +29,7 @@ FIELDS = {
     "coarse_first_output_ticks": values(0, 50, 100, 2001, -1),
     "coarse_output_every_ticks": values(0, 10, 100, 1000, -1),
     "coarse_ratio": values(0.0, 0.5, 0.999, 1.0, -0.5, NAN),
-    "coarse_method": values(0, 1, 2),
+    "coarse_method": values(0, 1, 2, 3, -1),
     "fine_ticks": values(0, 100, -1),
     "fine_states": values(0, 5, 8, 12, 6),
     "fine_meas_every_ticks": values(0, 1, -1),

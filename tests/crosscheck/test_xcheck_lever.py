@@ -36,7 +36,7 @@ def scenarios(draw):
     # model, and both amplify ulps without bound (the engines go equally
     # wrong, but not to 1e-10). So: waves with FIT, then navigation; or
     # navigation from the configured state.
-    method = draw(st.sampled_from([0, 1]))
+    method = draw(st.sampled_from([0, 1, 2]))
     states = draw(st.sampled_from([5, 8, 12]))
     waves = (kind == "coarse" and method == 1) or kind == "nav" or (kind == "fine" and states == 12)
     wave = draw(st.floats(0.0, 1.0)) if waves else 0.0

@@ -46,6 +46,8 @@ CASES = {
     "coarse_triad_fine5": (_swing, dict(**_SHORT_COARSE, **_SHORT_FINE, fine_states=5), "seed000", False),
     "coarse_triad_fine8_open": (_swing, dict(**_SHORT_COARSE, **_SHORT_FINE, fine_states=8,
                                              fine_correction=1, coarse_ratio=0.25), "seed000", False),
+    "coarse_eq8_fine5": (_swing, dict(**_SHORT_COARSE, **_SHORT_FINE, fine_states=5, coarse_method=2),
+                         "seed000", False),
     "moored_fit_fine12": (_moored, dict(**_SHORT_COARSE, **_SHORT_FINE, coarse_method=1,
                                         fine_states=12, fine_meas_every_ticks=20,
                                         integrity_nis_window=5), "seed000", False),

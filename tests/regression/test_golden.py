@@ -63,7 +63,7 @@ def test_compact_records_are_the_full_records_fields(name):
 
 def test_every_mode_and_scheme_is_covered():
     # the suite must reach every mode, every preset scheme and the custom one,
-    # both coarse methods and all three fine filters
+    # every coarse method (TRIAD, FIT, eq. 8) and all three fine filters
     seen_modes, schemes, methods, states = set(), set(), set(), set()
     for name in cases.CASES:
         d = np.load(os.path.join(DATA, f"{name}.npz"))
@@ -75,4 +75,4 @@ def test_every_mode_and_scheme_is_covered():
             states.add(cfg.get("fine_states", 5))
     assert {1, 2, 3} <= seen_modes
     assert schemes == {0, 1, 2, 3, 4, 5, 6}
-    assert {0, 1} <= methods and states == {5, 8, 12}
+    assert {0, 1, 2} <= methods and states == {5, 8, 12}
