@@ -212,15 +212,20 @@ def drift_surviving(yaw_p, mask=None):
 # IMU: a scale-factor or misalignment error turns the IMU's own rate into a
 # drift, eps^p(t) = (dK + M) omega_ip^p(t), and the accelerometers' into a
 # bias, nabla^p(t) = (dK_a + M_a) f^p(t) (the sensor model of
-# pyins.sim.sensors; Titterton & Weston, "Strapdown Inertial Navigation
-# Technology" (2nd ed., 2004), sec. 12.2 and 12.3; Qin 2014 sec. 4.2 for the
-# error equations). Seen in n, eps^n(t) = C_p^n(t) eps^p(t): the table angle,
-# the ship's swing and its tilt all enter, and the mean of that product over
-# the run is what a table cannot modulate. Example (seed 002 exp. 2, the
-# traditional two-position scheme, all six gyro misalignments +10"): the
-# deck's tilt (pitch 1 deg, roll -2 deg) times the misalignment times the
-# 6 deg/s yaw swing, locked in phase with the table's turns, leaves a mean up
-# drift of ~0.005 deg/h, more than the up gyro's own 0.003 deg/h.
+# pyins.sim.sensors; the instrument error terms as in Titterton & Weston,
+# "Strapdown Inertial Navigation Technology" (2nd ed., 2004), ch. 12; Qin
+# 2014 sec. 4.2 for the error equations). Seen in n, eps^n(t) = C_p^n(t)
+# eps^p(t): the table angle, the ship's swing and its tilt all enter, and
+# the mean of that product over the run is what a table cannot modulate.
+# Example (seed 002 exp. 2, the traditional two-position scheme, all six
+# gyro misalignments +10"): the yaw swing psi' about the vertical of n gives
+# an up drift psi' u^T M u, u = C_n^p e_Up = (u_x, u_y, ~1) the vertical
+# seen in the IMU, i.e. psi' [u_x (M_xz + M_zx) + u_y (M_yz + M_zy)] to first
+# order in the deck's tilt (pitch 1 deg, roll -2 deg), (u_x, u_y) turned by
+# the table angle. It averages out with a fixed table; with the table's
+# turns locked in phase to the swing it leaves a mean up drift of
+# +0.0045 deg/h, 1.5 times the up gyro's own 0.003 deg/h (10.2 nmi in 72 h
+# against 0.16 nmi on a level deck; docs/concepts.md, "The error budget").
 #
 # The model:
 #   1. the table angle between the records, rebuilt from the plant's recorded
