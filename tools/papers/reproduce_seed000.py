@@ -463,7 +463,7 @@ def main(argv=None):
     ap.add_argument("--seeds", type=int, default=5, help="noise seeds per heading (paper: 5)")
     ap.add_argument("--ratio-seeds", type=int, default=30,
                     help="noise seeds of the ratio study, Fig. 1's bands and the heading-noise split")
-    ap.add_argument("--methods", default="triad",
+    ap.add_argument("--methods", default="triad,eq8",
                     help="coarse methods of the ratio study, comma separated (firmware.coarse_method)")
     args = ap.parse_args(argv)
     methods = check_methods(args.methods)
