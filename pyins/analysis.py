@@ -697,7 +697,8 @@ def compare_with_run(model, nav):
     """How far the model's position errors (StaticErrors) lie from a run's
     (pyins.metrics.NavErrors) at the model's times: ``rel_max`` = max over
     the run of |(dN, dE) model - run| over the run's largest horizontal
-    error; ``rel_final`` the same at the end over the run's final one;
+    error; ``rel_final`` the same at the end over the run's final one,
+    ``rel_24h`` at 24 h over the run's error then (None if not reached);
     ``rel_level``, ``rel_heading``, ``rel_velocity`` the same as rel_max for
     (phi_E, phi_N), phi_U and (dv_E, dv_N)."""
     idx = np.searchsorted(nav.time_s, model.time_s - 1e-6)
@@ -711,7 +712,11 @@ def compare_with_run(model, nav):
         top = np.linalg.norm(r, axis=1).max()
         return float(np.linalg.norm(d, axis=1).max() / top) if top > 0 else float("inf")
     att, vel = nav.att_n_rad[idx], nav.vel_n_mps[idx, :2]
+    at_24h = np.flatnonzero(np.abs(model.time_s - 86400.0) < 1e-6)
+    rel_24h = (float(diff[at_24h[0]] / run_h[idx][at_24h[0]]) if len(at_24h) and run_h[idx][at_24h[0]] > 0
+               else None)
     return dict(rel_max=float(diff.max() / run_h.max()) if run_h.max() > 0 else float("inf"),
+                rel_24h=rel_24h,
                 rel_final=float(diff[-1] / run_h[-1]) if run_h[-1] > 0 else float("inf"),
                 diff_max_m=float(diff.max()), run_max_m=float(run_h.max()), run_final_m=float(run_h[-1]),
                 rel_level=rel(model.att_n_rad[:, :2] - att[:, :2], att[:, :2]),

@@ -111,7 +111,15 @@ def write_tables(out, out_dir):
         with open(os.path.join(out_dir, "budget_misalignment_tilt.md"), "w") as fh:
             fh.write("\n".join(level) + "\n")
     if check:
-        text += [f"All sources and sums within 10 %: {'yes' if out['all_within_10_percent'] else 'NO'} "
+        judged_rows = [(run, r) for run in out["runs"] for r in run["rows"]
+                       if "rel_max" in r and r["run_max_m"] >= FLOOR_M]
+        for key, what in (("rel_24h", "at 24 h"), ("rel_final", "at the end")):
+            vals = [(r[key], run, r) for run, r in judged_rows if r.get(key) is not None]
+            if vals:
+                v, run, r = max(vals, key=lambda x: x[0])
+                text.append(f"|model - FIL| / |FIL| {what} (north, east), worst of {len(vals)} rows: "
+                            f"{100 * v:.2f} % ({run['scenario']}, {run['scheme']}, {r['source']}).")
+        text += ["", f"All sources and sums within 10 %: {'yes' if out['all_within_10_percent'] else 'NO'} "
                  f"({out['wall_s']:.0f} s wall)."]
     with open(os.path.join(out_dir, "budget.md"), "w") as fh:
         fh.write("\n".join(text) + "\n")
