@@ -205,6 +205,56 @@ def drift_surviving(yaw_p, mask=None):
     return float(np.hypot(np.cos(sel).sum(), np.sin(sel).sum()) / len(psi))
 
 
+def drift_surviving_history(motion, table, nodes=4, chunk=7200):
+    """The proxy of ``drift_surviving`` at the full rate, without sampling:
+    (all, stopped, turning) = |time mean of [cos psi_p, sin psi_p]| over the
+    run, psi_p(t) = psi_b(t) + alpha(t) (the records' yaw_p_rad), the ship's
+    yaw from the analytic ``motion`` and the table angle from its history
+    ``table`` (`table_history`: exact between the plant's records when the
+    turns start within a tick, as seed 002's 600 deg/s^2; a corner in place
+    of a slower ramp), integrated by ``nodes`` Gauss-Legendre nodes on each
+    piece of each record interval. "stopped" sums the pieces where the table
+    rate is 0, "turning" the others; all three are divided by the whole
+    duration, so the parts add up as vectors.
+
+    Measured against 100 Hz records (every tick's yaw_p_rad): seed 002
+    exp. 2, traditional scheme, 72 h, 25.9 M records: 0.01570 / 0.00047 /
+    0.01563 both ways (1 Hz records: 0.0157 / 0.0005 / 0.0156); 1 h and 6 h
+    runs of both experiments agree with 100 Hz to 1e-5."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    k_all = len(table.t0)
+    c_all = s_all = c_stop = s_stop = 0.0
+    for a in range(0, k_all, chunk):
+        b = min(k_all, a + chunk)
+        t0, tk = table.t0[a:b, None], table.t_kink[a:b, None]
+        l1, l2 = tk - t0, t0 + table.h - tk
+        u = 0.5 * (1.0 + x)[None, :]
+        times = np.concatenate([t0 + l1 * u, tk + l2 * u], axis=1)           # (k, 2 nodes)
+        r0, r1 = table.rate0[a:b, None], table.rate1[a:b, None]
+        al = table.alpha0[a:b, None]
+        alpha = np.concatenate([al + r0 * l1 * u, al + r0 * l1 + r1 * l2 * u], axis=1)
+        rate = np.concatenate([np.broadcast_to(r0, (b - a, nodes)), np.broadcast_to(r1, (b - a, nodes))], axis=1)
+        weights = np.concatenate([l1 * w[None, :], l2 * w[None, :]], axis=1) / 2.0   # [s]
+        psi = motion.state(times.ravel()).euler[:, 2].reshape(times.shape) + alpha
+        cw, sw = np.cos(psi) * weights, np.sin(psi) * weights
+        stop = rate == 0.0
+        c_all, s_all = c_all + cw.sum(), s_all + sw.sum()
+        c_stop, s_stop = c_stop + cw[stop].sum(), s_stop + sw[stop].sum()
+    duration = k_all * table.h
+    return (float(np.hypot(c_all, s_all) / duration), float(np.hypot(c_stop, s_stop) / duration),
+            float(np.hypot(c_all - c_stop, s_all - s_stop) / duration))
+
+
+def drift_surviving_of_run(motion, result, config=None):
+    """``drift_surviving_history`` of a firmware-in-the-loop run (a
+    records.FilResult with its plant records, of ``motion``; ``config`` the
+    firmware configuration, for the initial table angle)."""
+    alpha0 = float((config or {}).get("table_angle_rad", 0.0))
+    t_rec = np.asarray(result.plant["tick"], dtype=float) * result.dt
+    table = table_history(t_rec, result.plant["alpha_rad"], result.plant["rate_rad_s"], alpha0, 0.0)
+    return drift_surviving_history(motion, table)
+
+
 # ---------------------------------------------------------------------------
 # The error budget: each sensor error's share, driven by the run's history
 # ---------------------------------------------------------------------------

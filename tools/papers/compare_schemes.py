@@ -65,7 +65,7 @@ def run_one(spec, progress):
     e = metrics.nav_errors(res)
     return {"max_nmi": float(e.horizontal_m.max() / NMI_TO_M),
             "final_nmi": float(e.horizontal_m[-1] / NMI_TO_M),
-            "survives": analysis.drift_surviving(res.outputs["yaw_p_rad"]),
+            "survives": analysis.drift_surviving_of_run(spec.motion, res, spec.config)[0],
             "fallbacks": int(res.outputs["index_fallbacks"][-1])}
 
 
