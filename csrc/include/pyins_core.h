@@ -97,8 +97,11 @@ enum pyins_index_scheme {
     PYINS_INDEX_FOUR_POSITION = 3,    /* stops at 0, 180, 90, 270: +180, -90, +180, -270 (no slip ring) */
     PYINS_INDEX_FLEXIBLE_TWO = 4,     /* seed 002 flexible: flex-cos fwd, +180, flex-sin rev, -180 */
     PYINS_INDEX_CUSTOM = 5,           /* index_steps[0 .. index_n_steps-1] */
-    PYINS_INDEX_FLEXIBLE_DERIVED = 6  /* seed 002's three-stop derivation: flex-cos fwd, flex-sin rev,
+    PYINS_INDEX_FLEXIBLE_DERIVED = 6, /* seed 002's three-stop derivation: flex-cos fwd, flex-sin rev,
                                          without the fixed 180-deg moves (docs/papers.md, seed 002 §6, note 3) */
+    PYINS_INDEX_HEADING_ISOLATION = 7 /* the table counter-rotates against the ship's yaw (holds the IMU
+                                         heading), plus a two-position cycle +180, -180 at the held heading
+                                         (docs/indexing.md) */
 };
 
 /* Which ticks add cos psi, sin psi to A_c, A_s (pyins_config.index_sums). */
@@ -336,6 +339,11 @@ typedef struct pyins_output {
                                      or when no static fine alignment follows or fine_noise is CONFIGURED */
     double fine_vrw;              /* the noise density the static fine filter's R is built from
                                      [(m/s)/sqrt(s)] (fine_noise); 0 before it starts and for fine_states 12 */
+    double index_travel_rad;      /* angle the motor was commanded to turn since init: sum of |change of
+                                     table_angle_cmd_rad| per tick (ABI 0.13) */
+    int32_t index_motor_starts;   /* motor starts since init: ticks whose commanded rate is non-zero
+                                     after a tick whose commanded rate was 0 (ABI 0.13) */
+    int32_t reserved1;
 } pyins_output;
 
 /* What the turntable's motor controller reads after every step, without

@@ -53,13 +53,15 @@ typedef struct pyins_t_index_params {
     int32_t n_steps;
     int32_t timeout_ticks;
     int32_t sums;                 /* enum pyins_index_sums */
-    int32_t reserved;
+    int32_t isolate;              /* 1: heading isolation */
     double rate, accel, delta, max_flex, tolerance, jump, dt;
 } pyins_t_index_params;
 
 typedef struct pyins_t_index_out {
     int32_t state, step, fault, fallbacks;
     double cmd_angle, cmd_rate, a_c, a_s;
+    int32_t motor_starts, reserved;
+    double travel;
 } pyins_t_index_out;
 
 typedef struct pyins_t_moving_params {

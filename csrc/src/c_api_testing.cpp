@@ -281,6 +281,7 @@ void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const dou
     prm.timeout_ticks = p->timeout_ticks;
     prm.sums = p->sums;
     prm.dt = p->dt;
+    prm.isolate = p->isolate;
     pyins::indexing::Indexer ix;
     pyins::indexing::init(ix, prm, meas0);
     for (size_t k = 0; k < n; ++k) {
@@ -299,6 +300,9 @@ void pyins_t_indexing_run(const pyins_t_index_params* p, double meas0, const dou
         out[k].cmd_rate = ix.cmd_rate;
         out[k].a_c = ix.a_c;
         out[k].a_s = ix.a_s;
+        out[k].motor_starts = ix.motor_starts;
+        out[k].reserved = 0;
+        out[k].travel = ix.travel;
     }
 }
 

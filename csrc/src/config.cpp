@@ -120,7 +120,7 @@ namespace {
 
 /// The indexing part of config_check, on a resolved configuration.
 int index_check(const pyins_config& cfg) {
-    if (cfg.index_scheme < PYINS_INDEX_NONE || cfg.index_scheme > PYINS_INDEX_FLEXIBLE_DERIVED) {
+    if (cfg.index_scheme < PYINS_INDEX_NONE || cfg.index_scheme > PYINS_INDEX_HEADING_ISOLATION) {
         return PYINS_E_CONFIG_INDEX_SCHEME;
     }
     if (cfg.index_scheme == PYINS_INDEX_NONE) {

@@ -130,6 +130,7 @@ void Firmware::init(const pyins_config& raw) {
     ip.timeout_ticks = cfg.index_timeout_ticks;
     ip.sums = cfg.index_sums;
     ip.dt = dt_;
+    ip.isolate = cfg.index_scheme == PYINS_INDEX_HEADING_ISOLATION ? 1 : 0;
     // Before NAVIGATE the table is held where it is (an idle machine, command 0).
     indexing::Params idle = ip;
     idle.n_steps = 0;
@@ -853,6 +854,9 @@ void Firmware::output(pyins_output* out) const {
     out->table_angle_cmd_rad = idx_.cmd_angle;
     out->index_a_c = idx_.a_c;
     out->index_a_s = idx_.a_s;
+    out->index_travel_rad = idx_.travel;
+    out->index_motor_starts = idx_.motor_starts;
+    out->reserved1 = 0;
     out->n_nonfinite = counts_.nonfinite;
     out->n_saturated = counts_.saturated;
     out->n_seq_gaps = counts_.seq_gaps;

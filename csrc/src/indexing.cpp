@@ -15,7 +15,7 @@ double sense(double angle) { return angle < 0.0 ? -1.0 : 1.0; }
 void start_stop(Indexer& ix) {
     ix.state = State::kStop;
     ix.stop_count = 0;
-    ix.cmd_rate = 0.0;
+    ix.cmd_rate = ix.hold_rate;   // 0 but while isolating
     ix.lag_ticks = 0;
 }
 
@@ -123,6 +123,10 @@ int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps) {
             steps[0] = Step{stop_ticks, Kind::kFlexCos, 1.0};
             steps[1] = Step{stop_ticks, Kind::kFlexSin, -1.0};
             return 2;
+        case 7:  // heading isolation (seed 002, refs. 7-8): two positions at the held heading
+            steps[0] = Step{stop_ticks, fx, kPi};
+            steps[1] = Step{stop_ticks, fx, -kPi};
+            return 2;
         default:
             return -1;
     }
@@ -140,6 +144,12 @@ void init(Indexer& ix, const Params& prm, double meas) {
     ix.move_start = meas;
     ix.prev_meas = meas;
     ix.target_known = true;
+    ix.have_heading = false;
+    ix.motor_starts = 0;
+    ix.travel = 0.0;
+    ix.hold_rate = 0.0;
+    ix.prev_sin = 0.0;
+    ix.prev_cos = 0.0;
     if (prm.n_steps == 0) {
         ix.state = State::kIdle;
         ix.stop_count = 0;
@@ -154,21 +164,28 @@ void reset(Indexer& ix, double meas) {
     const double a_c = ix.a_c;
     const double a_s = ix.a_s;
     const int32_t fallbacks = ix.fallbacks;
+    const int32_t starts = ix.motor_starts;
+    const double travel = ix.travel;
     init(ix, ix.prm, meas);
     ix.a_c = a_c;
     ix.a_s = a_s;
     ix.fallbacks = fallbacks;
+    ix.motor_starts = starts;
+    ix.travel = travel;
 }
 
 bool wants_heading(const Indexer& ix) {
     if (ix.state == State::kStop) {
         return true;
     }
-    return ix.state == State::kMove && (ix.prm.sums == kSumsAll || !ix.target_known);
+    return ix.state == State::kMove && (ix.prm.sums == kSumsAll || !ix.target_known || ix.prm.isolate != 0);
 }
 
-void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
-    const double jumped = std::fabs(meas - ix.prev_meas);
+namespace {
+
+void step_machine(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
+    const double dmeas = meas - ix.prev_meas;
+    const double jumped = std::fabs(dmeas);
     ix.prev_meas = meas;
     if (ix.state == State::kIdle || ix.state == State::kFault) {
         return;
@@ -177,11 +194,27 @@ void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
         enter_fault(ix, Fault::kJump);
         return;
     }
+    // heading isolation: d = -d psi_b = d alpha - d psi_p (see the header)
+    const double hold_prev = ix.hold_rate;
+    double d = 0.0;
+    if (ix.prm.isolate != 0) {
+        if (ix.have_heading) {
+            d = dmeas - (sin_yaw_p * ix.prev_cos - cos_yaw_p * ix.prev_sin);
+        }
+        ix.prev_sin = sin_yaw_p;
+        ix.prev_cos = cos_yaw_p;
+        ix.have_heading = true;
+        ix.hold_rate = d / ix.prm.dt;
+    }
     if (ix.state == State::kStop) {
         // A_c, A_s accumulate cos and sin of psi_p while stopped (seed 002 sec. 2)
         ix.a_c = ix.a_c + cos_yaw_p;
         ix.a_s = ix.a_s + sin_yaw_p;
         ix.stop_count = ix.stop_count + 1;
+        if (ix.prm.isolate != 0) {
+            ix.cmd_angle = ix.cmd_angle + d;
+            ix.cmd_rate = ix.hold_rate;
+        }
         if (off_command(ix, meas, Fault::kDrift)) {
             return;
         }
@@ -209,7 +242,18 @@ void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
             ix.fallbacks = ix.fallbacks + 1;
         }
     }
+    if (ix.prm.isolate != 0) {
+        // the profile's own rate, then the counter-rotation on angle and target
+        ix.cmd_rate = ix.cmd_rate - hold_prev;
+        ix.cmd_angle = ix.cmd_angle + d;
+        ix.target = ix.target + d;
+    }
+    const double before = ix.cmd_angle;
     const bool arrived = advance_command(ix);
+    // isolating, the rate is the command's change (the last, partial step of a
+    // move included, which the profile leaves at rate 0): a rate-following
+    // table then keeps the held heading over any number of moves
+    const double rate_iso = (ix.cmd_angle - before) / ix.prm.dt + ix.hold_rate;
     if (off_command(ix, meas, Fault::kLag)) {
         return;
     }
@@ -217,6 +261,21 @@ void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
         ix.step = (ix.step + 1) % ix.prm.n_steps;
         start_stop(ix);
     }
+    if (ix.prm.isolate != 0) {
+        ix.cmd_rate = rate_iso;
+    }
+}
+
+}  // namespace
+
+void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) {
+    const double rate0 = ix.cmd_rate;
+    const double angle0 = ix.cmd_angle;
+    step_machine(ix, meas, sin_yaw_p, cos_yaw_p);
+    if (rate0 == 0.0 && ix.cmd_rate != 0.0) {
+        ix.motor_starts = ix.motor_starts + 1;   // the motor leaves rest
+    }
+    ix.travel = ix.travel + std::fabs(ix.cmd_angle - angle0);
 }
 
 }  // namespace pyins::indexing

@@ -30,6 +30,24 @@
 // - faults: the encoder lagging the command by more than `tolerance` for
 //   `timeout_ticks` (stall, jam, wrong direction), or jumping by more than
 //   `jump` in one tick, or drifting off a stop: FAULT, command 0, until reset.
+//
+// Heading isolation (`isolate` = 1, scheme PYINS_INDEX_HEADING_ISOLATION; the
+// scheme seed 002 argues against, its refs. 7-8): on every tick of a stop or
+// move the table also turns by minus the ship's yaw change, so that the IMU
+// heading psi_p stays where the cycle puts it. The ship's yaw change comes
+// from the solution: d psi_b = d psi_p - d alpha, with d alpha the encoder's
+// change and d psi_p taken as the sine of the change of psi_p between two
+// ticks, s_k c_(k-1) - c_k s_(k-1) (psi_p is held, so it is tiny and the sine
+// is exact to its cube). The counter-rotation d = -d psi_b is added to the
+// commanded angle (and to a move's target, so the move's own profile is
+// unchanged) and d / dt to the commanded rate. The first tick after init or
+// reset has no previous heading and turns by 0.
+//
+// Counters, every scheme: a motor start is a tick whose commanded rate is
+// non-zero after a tick whose commanded rate was 0 (a move leaving a stop, or
+// the counter-rotation starting); travel is the sum of |change of the
+// commanded angle| over the ticks (the angle the motor is asked to turn, the
+// counter-rotation included). Both survive a reset.
 #pragma once
 
 #include <cstdint>
@@ -62,6 +80,7 @@ struct Params {
     int32_t timeout_ticks; ///< how long the encoder may lag
     int32_t sums;          ///< kSumsStops: A_c, A_s over stopped ticks (seed 002); kSumsAll: every tick
     double dt;             ///< tick [s]
+    int32_t isolate;       ///< 1: heading isolation (counter-rotate against the ship's yaw)
 };
 
 struct Indexer {
@@ -80,12 +99,19 @@ struct Indexer {
     double move_start;     ///< commanded angle at the start of the move [rad]
     double prev_meas;      ///< last encoder reading (unwrapped) [rad]
     bool target_known;     ///< fixed move, or flexible condition met / fallback
+    bool have_heading;     ///< prev_sin, prev_cos hold the last tick's heading (isolate)
+    int32_t motor_starts;  ///< ticks whose commanded rate left 0
+    double travel;         ///< sum of |change of the commanded angle| [rad]
+    double hold_rate;      ///< this tick's counter-rotation rate [rad/s] (0 without isolate)
+    double prev_sin;       ///< sin psi_p of the last tick (isolate)
+    double prev_cos;       ///< cos psi_p of the last tick (isolate)
 };
 
 /// Preset schemes (enum pyins_index_scheme): 0 none, 1 single-position
 /// forward/reverse (seed 003), 2 traditional two-position (seed 002),
 /// 3 four-position, 4 flexible two-position (seed 002), 6 the flexible scheme
-/// of seed 002's derivation without the fixed 180-deg moves. Writes the cycle into
+/// of seed 002's derivation without the fixed 180-deg moves, 7 heading
+/// isolation (a two-position cycle, +180 and -180, at the held heading). Writes the cycle into
 /// steps (room for kMaxSteps) and returns its length, or -1 if unknown.
 int32_t preset_steps(int32_t scheme, int32_t stop_ticks, Step* steps);
 
@@ -102,7 +128,8 @@ bool wants_heading(const Indexer& ix);
 /// from the solution (read only where wants_heading says; 0 otherwise).
 void update(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p);
 
-/// Leave FAULT: start the cycle again at the measured angle, keeping A_c, A_s.
+/// Leave FAULT: start the cycle again at the measured angle, keeping A_c, A_s
+/// and the counters.
 void reset(Indexer& ix, double meas);
 
 }  // namespace pyins::indexing

@@ -58,6 +58,7 @@ PYINS_INDEX_FOUR_POSITION = 3
 PYINS_INDEX_FLEXIBLE_TWO = 4
 PYINS_INDEX_CUSTOM = 5
 PYINS_INDEX_FLEXIBLE_DERIVED = 6
+PYINS_INDEX_HEADING_ISOLATION = 7
 
 # --- enum pyins_index_sums --------------------------------------------------
 PYINS_INDEX_SUMS_STOPS = 0
@@ -124,7 +125,7 @@ ENUMS = {
         ("pyins_status", [n for n in dir() if n.startswith(("PYINS_OK", "PYINS_E_", "PYINS_W_"))]),
         ("pyins_index_scheme", ["PYINS_INDEX_NONE", "PYINS_INDEX_SINGLE_FWD_REV", "PYINS_INDEX_TWO_POSITION",
                                 "PYINS_INDEX_FOUR_POSITION", "PYINS_INDEX_FLEXIBLE_TWO", "PYINS_INDEX_CUSTOM",
-                                "PYINS_INDEX_FLEXIBLE_DERIVED"]),
+                                "PYINS_INDEX_FLEXIBLE_DERIVED", "PYINS_INDEX_HEADING_ISOLATION"]),
         ("pyins_index_sums", ["PYINS_INDEX_SUMS_STOPS", "PYINS_INDEX_SUMS_ALL"]),
         ("pyins_index_kind", ["PYINS_INDEX_FIXED", "PYINS_INDEX_FLEX_COS", "PYINS_INDEX_FLEX_SIN"]),
         ("pyins_index_state", ["PYINS_INDEX_IDLE", "PYINS_INDEX_STOP", "PYINS_INDEX_MOVE",

@@ -184,7 +184,7 @@ def config_resolved(cfg):
 def index_check(cfg):
     """The indexing part of config_check (mirrors index_check)."""
     scheme = cfg["index_scheme"]
-    if scheme < abi.PYINS_INDEX_NONE or scheme > abi.PYINS_INDEX_FLEXIBLE_DERIVED:
+    if scheme < abi.PYINS_INDEX_NONE or scheme > abi.PYINS_INDEX_HEADING_ISOLATION:
         return abi.PYINS_E_CONFIG_INDEX_SCHEME
     if scheme == abi.PYINS_INDEX_NONE:
         return abi.PYINS_OK

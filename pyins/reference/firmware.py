@@ -119,7 +119,8 @@ class Firmware:
             steps=steps, rate=cfg["index_rate_rad_s"], accel=cfg["index_accel_rad_s2"],
             delta=cfg["index_delta"], max_flex=cfg["index_max_flex_rad"],
             tolerance=cfg["index_tolerance_rad"], jump=cfg["index_jump_rad"],
-            timeout_ticks=cfg["index_timeout_ticks"], dt=self.dt, sums=cfg["index_sums"])
+            timeout_ticks=cfg["index_timeout_ticks"], dt=self.dt, sums=cfg["index_sums"],
+            isolate=1 if cfg["index_scheme"] == abi.PYINS_INDEX_HEADING_ISOLATION else 0)
         idle = indexing.Params(**{**self.index_prm.__dict__, "steps": []})
         self.idx = indexing.init(idle, self.table_angle)
         self.coarse = None
@@ -605,6 +606,8 @@ class Firmware:
             "index_fallbacks": self.idx.fallbacks,
             "index_a_c": self.idx.a_c,
             "index_a_s": self.idx.a_s,
+            "index_travel_rad": self.idx.travel,
+            "index_motor_starts": self.idx.motor_starts,
             "kf_states": self.kf_states,
             "align_restarts": self.align_restarts,
             **self.counts,

@@ -50,6 +50,7 @@ class Params:
     timeout_ticks: int
     dt: float
     sums: int = SUMS_STOPS   # (C++: after timeout_ticks; a default here keeps old callers working)
+    isolate: int = 0         # 1: heading isolation (indexing.hpp)
 
     @property
     def n_steps(self):
@@ -73,6 +74,12 @@ class Indexer:
     move_start: float = 0.0
     prev_meas: float = 0.0
     target_known: bool = True
+    have_heading: bool = False
+    motor_starts: int = 0
+    travel: float = 0.0
+    hold_rate: float = 0.0
+    prev_sin: float = 0.0
+    prev_cos: float = 0.0
 
 
 def _sense(angle):
@@ -82,7 +89,7 @@ def _sense(angle):
 def _start_stop(ix):
     ix.state = STATE_STOP
     ix.stop_count = 0
-    ix.cmd_rate = 0.0
+    ix.cmd_rate = ix.hold_rate   # 0 but while isolating
     ix.lag_ticks = 0
 
 
@@ -155,6 +162,7 @@ def preset_steps(scheme, stop_ticks):
         3: [(fx, pi), (fx, -0.5 * pi), (fx, pi), (fx, -1.5 * pi)],
         4: [(KIND_FLEX_COS, 1.0), (fx, pi), (KIND_FLEX_SIN, -1.0), (fx, -pi)],
         6: [(KIND_FLEX_COS, 1.0), (KIND_FLEX_SIN, -1.0)],
+        7: [(fx, pi), (fx, -pi)],    # heading isolation: two positions at the held heading
     }
     if scheme not in table:
         return None
@@ -174,6 +182,7 @@ def reset(ix, meas):
     """Leave FAULT: start the cycle again at ``meas``, keeping A_c, A_s."""
     new = init(ix.prm, meas)
     new.a_c, new.a_s, new.fallbacks = ix.a_c, ix.a_s, ix.fallbacks
+    new.motor_starts, new.travel = ix.motor_starts, ix.travel
     return new
 
 
@@ -182,24 +191,46 @@ def wants_heading(ix):
     ``indexing::wants_heading``)."""
     if ix.state == STATE_STOP:
         return True
-    return ix.state == STATE_MOVE and (ix.prm.sums == SUMS_ALL or not ix.target_known)
+    return ix.state == STATE_MOVE and (ix.prm.sums == SUMS_ALL or not ix.target_known
+                                       or ix.prm.isolate != 0)
 
 
 def update(ix, meas, sin_yaw_p, cos_yaw_p):
     """One tick (mirrors ``indexing::update``); the heading as its sine and
-    cosine, read only where ``wants_heading`` says."""
-    jumped = abs(meas - ix.prev_meas)
+    cosine, read only where ``wants_heading`` says. Counts the motor starts
+    (commanded rate from 0 to non-zero) and the commanded travel."""
+    rate0, angle0 = ix.cmd_rate, ix.cmd_angle
+    _step_machine(ix, meas, sin_yaw_p, cos_yaw_p)
+    if rate0 == 0.0 and ix.cmd_rate != 0.0:
+        ix.motor_starts = ix.motor_starts + 1
+    ix.travel = ix.travel + abs(ix.cmd_angle - angle0)
+
+
+def _step_machine(ix, meas, sin_yaw_p, cos_yaw_p):
+    dmeas = meas - ix.prev_meas
+    jumped = abs(dmeas)
     ix.prev_meas = meas
     if ix.state in (STATE_IDLE, STATE_FAULT):
         return
     if jumped > ix.prm.jump:
         _enter_fault(ix, FAULT_JUMP)
         return
+    # heading isolation: d = -d psi_b = d alpha - d psi_p (indexing.hpp)
+    hold_prev = ix.hold_rate
+    d = 0.0
+    if ix.prm.isolate != 0:
+        if ix.have_heading:
+            d = dmeas - (sin_yaw_p * ix.prev_cos - cos_yaw_p * ix.prev_sin)
+        ix.prev_sin, ix.prev_cos, ix.have_heading = sin_yaw_p, cos_yaw_p, True
+        ix.hold_rate = d / ix.prm.dt
     if ix.state == STATE_STOP:
         # A_c, A_s accumulate cos and sin of psi_p while stopped (seed 002 sec. 2)
         ix.a_c = ix.a_c + cos_yaw_p
         ix.a_s = ix.a_s + sin_yaw_p
         ix.stop_count = ix.stop_count + 1
+        if ix.prm.isolate != 0:
+            ix.cmd_angle = ix.cmd_angle + d
+            ix.cmd_rate = ix.hold_rate
         if _off_command(ix, meas, FAULT_DRIFT):
             return
         if ix.stop_count == ix.prm.steps[ix.step].stop_ticks:
@@ -219,12 +250,22 @@ def update(ix, meas, sin_yaw_p, cos_yaw_p):
         elif abs(ix.cmd_angle - ix.move_start) >= ix.prm.max_flex:
             ix.target_known = True
             ix.fallbacks = ix.fallbacks + 1
+    if ix.prm.isolate != 0:
+        # the profile's own rate, then the counter-rotation on angle and target
+        ix.cmd_rate = ix.cmd_rate - hold_prev
+        ix.cmd_angle = ix.cmd_angle + d
+        ix.target = ix.target + d
+    before = ix.cmd_angle
     arrived = _advance_command(ix)
+    # isolating, the rate is the command's change, a move's partial last step included
+    rate_iso = (ix.cmd_angle - before) / ix.prm.dt + ix.hold_rate
     if _off_command(ix, meas, FAULT_LAG):
         return
     if arrived and ix.target_known:
         ix.step = (ix.step + 1) % ix.prm.n_steps
         _start_stop(ix)
+    if ix.prm.isolate != 0:
+        ix.cmd_rate = rate_iso
 
 
 def run(prm, meas0, meas, yaw_b):
@@ -239,5 +280,5 @@ def run(prm, meas0, meas, yaw_b):
             sn, cs = np.sin(yaw_b[k] + m), np.cos(yaw_b[k] + m)
         update(ix, m, sn, cs)
         out.append((ix.state, ix.step, ix.fault, ix.fallbacks, ix.cmd_angle, ix.cmd_rate,
-                    ix.a_c, ix.a_s))
+                    ix.a_c, ix.a_s, ix.motor_starts, 0, ix.travel))
     return out

@@ -192,7 +192,8 @@ TURNTABLE_KEYS = {
 
 #: scheme name -> pyins_index_scheme; "seed003" is another name of single_position.
 INDEX_SCHEMES = {"none": 0, "single_position": 1, "seed003": 1, "two_position": 2,
-                 "four_position": 3, "flexible": 4, "custom": 5, "flexible_derived": 6}
+                 "four_position": 3, "flexible": 4, "custom": 5, "flexible_derived": 6,
+                 "heading_isolation": 7}
 _STEP_MOVES = {"fixed": 1, "flex_cos": 2, "flex_sin": 3}
 #: sums name -> pyins_index_sums
 INDEX_SUMS = {"stops": 0, "all": 1}

@@ -16,7 +16,7 @@ from pyins import units
 DEG = units.DEG_TO_RAD
 
 
-@pytest.mark.parametrize("scheme, sums", [(2, 0), (4, 0), (6, 1)])
+@pytest.mark.parametrize("scheme, sums", [(2, 0), (4, 0), (6, 1), (7, 0)])
 def test_fil_cpp_equals_numpy(scheme, sums):
     m = sim.HeadingSwing.experiment(1)
     n = 1500
@@ -46,8 +46,9 @@ def test_fil_cpp_equals_numpy(scheme, sums):
         c = res.outputs[k]
         assert c["seq"] == r["seq"] == k + 1, k      # both plants count the IMU's packets alike
         assert abs(res.plant["alpha_rad"][k] - st.alpha_rad) < 1e-10, k
-        for f in ("index_state", "index_step", "index_fallbacks"):
+        for f in ("index_state", "index_step", "index_fallbacks", "index_motor_starts"):
             assert c[f] == r[f], (k, f)
+        assert abs(c["index_travel_rad"] - r["index_travel_rad"]) < 1e-9, k
         q_err = attitude.quat_mul(c["quat_np"], attitude.quat_conj(r["quat_np"]))
         assert np.linalg.norm(attitude.quat_to_rotvec(attitude.quat_normalize(q_err))) < 1e-10, k
         moved += c["index_state"] == 2

@@ -19,18 +19,19 @@ from pyins.units import DEG_TO_RAD, DT
 
 DEG = DEG_TO_RAD
 RECORD = np.dtype([("state", "i4"), ("step", "i4"), ("fault", "i4"), ("fallbacks", "i4"),
-                   ("cmd_angle", "f8"), ("cmd_rate", "f8"), ("a_c", "f8"), ("a_s", "f8")])
+                   ("cmd_angle", "f8"), ("cmd_rate", "f8"), ("a_c", "f8"), ("a_s", "f8"),
+                   ("motor_starts", "i4"), ("reserved", "i4"), ("travel", "f8")])
 
 
 @st.composite
 def setups(draw):
-    scheme = draw(st.sampled_from([1, 2, 3, 4, 6]))
+    scheme = draw(st.sampled_from([1, 2, 3, 4, 6, 7]))
     stop = draw(st.integers(20, 400))
     steps = ix.preset_steps(scheme, stop)
     prm = ix.Params(steps=steps, rate=draw(st.sampled_from([6.0, 10.0, 30.0])) * DEG,
                     accel=draw(st.sampled_from([30.0, 100.0, 1e4])) * DEG, delta=0.01,
                     max_flex=2 * np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=DT,
-                    sums=draw(st.sampled_from([ix.SUMS_STOPS, ix.SUMS_ALL])))
+                    sums=draw(st.sampled_from([ix.SUMS_STOPS, ix.SUMS_ALL])), isolate=int(scheme == 7))
     n = draw(st.integers(500, 6000))
     t = np.arange(n) * 0.01
     amp = draw(st.floats(0.0, 120.0)) * DEG
@@ -46,6 +47,7 @@ def c_run(prm, meas0, yaw_b):
     p.n_steps = prm.n_steps
     p.timeout_ticks = prm.timeout_ticks
     p.sums = prm.sums
+    p.isolate = prm.isolate
     p.rate, p.accel, p.delta, p.max_flex = prm.rate, prm.accel, prm.delta, prm.max_flex
     p.tolerance, p.jump, p.dt = prm.tolerance, prm.jump, prm.dt
     y = np.ascontiguousarray(yaw_b)
@@ -56,7 +58,7 @@ def c_run(prm, meas0, yaw_b):
 
 
 def test_presets_match():
-    for scheme in range(8):
+    for scheme in range(9):
         p = hooks.ffi.new("pyins_t_index_params *")
         n = hooks.lib.pyins_t_index_preset(scheme, 123, p)
         ref = ix.preset_steps(scheme, 123)
@@ -74,9 +76,9 @@ def test_cpp_equals_reference_tick_for_tick(setup):
     prm, yaw_b, meas0 = setup
     c = c_run(prm, meas0, yaw_b)
     r = np.array(ix.run(prm, meas0, None, yaw_b), dtype=RECORD)
-    for f in ("state", "step", "fault", "fallbacks"):
+    for f in ("state", "step", "fault", "fallbacks", "motor_starts"):
         assert np.array_equal(c[f], r[f]), f
-    for f in ("cmd_angle", "cmd_rate", "a_c", "a_s"):
+    for f in ("cmd_angle", "cmd_rate", "a_c", "a_s", "travel"):
         np.testing.assert_allclose(c[f], r[f], rtol=0, atol=1e-9, err_msg=f)
 
 
@@ -87,6 +89,15 @@ def test_scheme_rules(setup):
     rec = np.array(ix.run(prm, meas0, None, yaw_b), dtype=RECORD)
     state, step = rec["state"], rec["step"]
     assert np.all(state != ix.STATE_FAULT)           # an ideal encoder never faults
+    # counters (every scheme): a start per tick whose rate left 0, travel = sum |d cmd_angle|
+    rate = np.concatenate([[0.0], rec["cmd_rate"]])
+    assert rec["motor_starts"][-1] == np.count_nonzero((rate[:-1] == 0.0) & (rate[1:] != 0.0))
+    np.testing.assert_allclose(rec["travel"], np.cumsum(np.abs(np.diff(np.concatenate(
+        [[meas0], rec["cmd_angle"]])))), rtol=1e-12, atol=1e-12)
+    if prm.isolate:
+        return      # the rules below are of a table that stands still between moves
+    # without isolation a motor start is a move leaving its stop
+    assert rec["motor_starts"][-1] == np.count_nonzero(np.diff(state) == ix.STATE_MOVE - ix.STATE_STOP)
     # the ticks that accumulate: A_c or A_s changed (cos and sin are never both 0)
     prev_ac = np.concatenate([[0.0], rec["a_c"][:-1]])
     prev_as = np.concatenate([[0.0], rec["a_s"][:-1]])

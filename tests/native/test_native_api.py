@@ -19,7 +19,7 @@ def static_samples(n, lat=0.5):
 def test_layout_matches_library():
     assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 64
     assert native.SAMPLE_DTYPE.fields["seq"][1] == 56
-    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 432   # + coarse_vrw, fine_vrw (ABI 0.10)
+    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 448   # + motor counters (ABI 0.13)
     assert native.OUTPUT_DTYPE.itemsize % 8 == 0
     assert native.NAV_DTYPE.itemsize == native.lib.pyins_sizeof_nav() == 160   # the compact record (ABI 0.12)
     assert set(native.NAV_DTYPE.names) < set(native.OUTPUT_DTYPE.names)
