@@ -48,7 +48,10 @@ import stack_depth  # noqa: E402
 from pyins import native  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12")
+MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "nav_null", "nav_compact")
+#: the rows that are the "nav" scenario through another API (bench_step's API argument and
+#: the function callgrind counts): no record, a compact record every tick
+API_OF = {"nav_null": ("nav", "null", "pyins_run"), "nav_compact": ("nav", "compact", "pyins_run_nav")}
 TARGETS = (("cortex-m7", "build-m7", "mps2-an500"), ("cortex-m4f", "build-m4", "mps2-an386"))
 TICK_HZ = 100
 
@@ -64,15 +67,17 @@ def size_of(path):
 
 
 def callgrind_per_tick(mode, ticks):
-    """Instructions per pyins_step on the host (callgrind), or None."""
+    """Instructions per tick inside pyins_step (or, for the API_OF rows, the
+    function of that API) on the host (callgrind), or None."""
     exe = os.path.join(ROOT, "build", "host", "bench_step")
     if shutil.which("valgrind") is None:
         return None
     subprocess.run(["cmake", "--build", os.path.join(ROOT, "build", "host"), "--target", "bench_step"],
                    check=True, capture_output=True)
     out = os.path.join(ROOT, "build", "host", f"callgrind.size_report.{mode}.out")
-    res = subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=pyins_step",
-                          f"--callgrind-out-file={out}", exe, str(ticks), mode],
+    scenario, api, function = API_OF.get(mode, (mode, "step", "pyins_step"))
+    res = subprocess.run(["valgrind", "--tool=callgrind", f"--toggle-collect={function}",
+                          f"--callgrind-out-file={out}", exe, str(ticks), scenario, api],
                          capture_output=True, text=True)
     for line in res.stderr.splitlines():
         if "Collected :" in line:
@@ -167,13 +172,13 @@ def main(argv=None):
         print(f"\ninstructions per tick (host: callgrind, {args.ticks} ticks; Cortex-M: QEMU -icount, 3000 ticks, "
               f"mean / worst tick); budget = instructions x CPI {args.cpi:g} as % of a {1000 // TICK_HZ} ms tick "
               f"at {args.m7_mhz:g} MHz (M7) / {args.m4_mhz:g} MHz (M4F)")
-        print(f"{'mode':7s} {'host x86-64':>11s} {'M7 mean':>9s} {'M7 worst':>9s} {'M4F mean':>9s} "
+        print(f"{'mode':11s} {'host x86-64':>11s} {'M7 mean':>9s} {'M7 worst':>9s} {'M4F mean':>9s} "
               f"{'M4F worst':>10s} {'M4F/M7':>7s} {'M7 %tick':>15s} {'M4F %tick':>15s}")
         for m in MODES:
             h = host.get(m)
             if h is not None:
                 fig[f"host_x86_64_{m}_callgrind_instructions_per_tick"] = h
-            row = f"{m:7s} {h if h is not None else float('nan'):11,.0f}"
+            row = f"{m:11s} {h if h is not None else float('nan'):11,.0f}"
             pct = {}
             for cpu in ("cortex-m7", "cortex-m4f"):
                 if cpu not in target or m not in target[cpu]:

@@ -93,6 +93,50 @@ int main(void) {
         printf("MODE %s ticks %d sum %lu max %lu maxtick %ld mode %ld\n", bench_mode_name[m], BENCH_TICKS,
                (unsigned long)sum, (unsigned long)worst, worst_tick, (long)out.mode);
     }
+    /* The navigation scenario again, as a firmware that reads the motor
+     * command every tick takes it: no record (pyins_run with outputs NULL,
+     * the command from pyins_get_motor_command outside the count), and a
+     * compact record every tick (pyins_run_nav). */
+    for (k = 0; k < 2; ++k) {
+        uint32_t sum = 0, worst = 0;
+        long i, worst_tick = -1;
+        double cmd = 0.0;
+        m = bench_mode_of("nav");
+        if (bench_config(m, BENCH_TICKS, &cfg) != 0 || pyins_init(g_mem, sizeof g_mem, &cfg) != PYINS_OK) {
+            printf("FAIL init nav (%s)\n", k == 0 ? "null" : "compact");
+            return 3;
+        }
+        for (i = 0; i < BENCH_TICKS; ++i) {
+            pyins_nav nav[2];   /* the capacity a call of n samples needs: n / every + 1 */
+            pyins_motor_command mc;
+            size_t done = 0, n_out = 0;
+            uint32_t c;
+            int st;
+            bench_sample(m, i, cmd, &s);
+            t0 = SYST_CVR;
+            st = k == 0 ? pyins_run((pyins_core *)g_mem, &s, 1, NULL, NULL)
+                        : pyins_run_nav((pyins_core *)g_mem, &s, 1, 1, nav, 2, &done, &n_out);
+            t1 = SYST_CVR;
+            if (st != PYINS_OK) {
+                printf("FAIL step nav (%s) %ld %d\n", k == 0 ? "null" : "compact", i, st);
+                return 4;
+            }
+            if (k == 0) {
+                pyins_get_motor_command((const pyins_core *)g_mem, &mc);
+                cmd = mc.angle_rad;
+            } else {
+                cmd = nav[0].table_angle_cmd_rad;
+            }
+            c = elapsed(t0, t1);
+            sum += c;
+            if (c > worst) {
+                worst = c;
+                worst_tick = i;
+            }
+        }
+        printf("MODE %s ticks %d sum %lu max %lu maxtick %ld\n", k == 0 ? "nav_null" : "nav_compact",
+               BENCH_TICKS, (unsigned long)sum, (unsigned long)worst, worst_tick);
+    }
     printf("DONE\n");
     return 0;
 }
