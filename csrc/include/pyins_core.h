@@ -361,7 +361,7 @@ typedef struct pyins_motor_command {
  * the same names, bit for bit, without the Euler angles, the heading, the
  * alignment filter's state and the counters, whose derivation costs as much
  * as the navigation tick (pyins_run_nav, pyins_get_nav). 160 bytes against
- * pyins_output's 432. */
+ * pyins_output's 448. */
 typedef struct pyins_nav {
     int64_t tick;                 /* = pyins_output.tick */
     int32_t mode;                 /* = pyins_output.mode (enum pyins_mode) */
