@@ -205,6 +205,24 @@ def drift_surviving(yaw_p, mask=None):
     return float(np.hypot(np.cos(sel).sum(), np.sin(sel).sum()) / len(psi))
 
 
+def _table_nodes(table, a, b, x, w):
+    """Gauss-Legendre nodes (x, w on [-1, 1]) on the record intervals a..b-1
+    of ``table`` (`table_history`), each split at its kink: (times, alpha,
+    rate, weights), each (b - a, 2 len(x)); the weights are in seconds (they
+    sum to the interval, h)."""
+    nodes = len(x)
+    t0, tk = table.t0[a:b, None], table.t_kink[a:b, None]
+    l1, l2 = tk - t0, t0 + table.h - tk
+    u = 0.5 * (1.0 + x)[None, :]
+    times = np.concatenate([t0 + l1 * u, tk + l2 * u], axis=1)
+    r0, r1 = table.rate0[a:b, None], table.rate1[a:b, None]
+    al = table.alpha0[a:b, None]
+    alpha = np.concatenate([al + r0 * l1 * u, al + r0 * l1 + r1 * l2 * u], axis=1)
+    rate = np.concatenate([np.broadcast_to(r0, (b - a, nodes)), np.broadcast_to(r1, (b - a, nodes))], axis=1)
+    weights = np.concatenate([l1 * w[None, :], l2 * w[None, :]], axis=1) / 2.0
+    return times, alpha, rate, weights
+
+
 def drift_surviving_history(motion, table, nodes=4, chunk=7200):
     """The proxy of ``drift_surviving`` at the full rate, without sampling:
     (all, stopped, turning) = |time mean of [cos psi_p, sin psi_p]| over the
@@ -226,15 +244,7 @@ def drift_surviving_history(motion, table, nodes=4, chunk=7200):
     c_all = s_all = c_stop = s_stop = 0.0
     for a in range(0, k_all, chunk):
         b = min(k_all, a + chunk)
-        t0, tk = table.t0[a:b, None], table.t_kink[a:b, None]
-        l1, l2 = tk - t0, t0 + table.h - tk
-        u = 0.5 * (1.0 + x)[None, :]
-        times = np.concatenate([t0 + l1 * u, tk + l2 * u], axis=1)           # (k, 2 nodes)
-        r0, r1 = table.rate0[a:b, None], table.rate1[a:b, None]
-        al = table.alpha0[a:b, None]
-        alpha = np.concatenate([al + r0 * l1 * u, al + r0 * l1 + r1 * l2 * u], axis=1)
-        rate = np.concatenate([np.broadcast_to(r0, (b - a, nodes)), np.broadcast_to(r1, (b - a, nodes))], axis=1)
-        weights = np.concatenate([l1 * w[None, :], l2 * w[None, :]], axis=1) / 2.0   # [s]
+        times, alpha, rate, weights = _table_nodes(table, a, b, x, w)
         psi = motion.state(times.ravel()).euler[:, 2].reshape(times.shape) + alpha
         cw, sw = np.cos(psi) * weights, np.sin(psi) * weights
         stop = rate == 0.0
@@ -444,15 +454,8 @@ def error_drive(motion, table, sources, nodes=4, chunk=7200):
     nab = np.zeros_like(eps)
     for a in range(0, k_all, chunk):
         b = min(k_all, a + chunk)
-        t0, tk = table.t0[a:b, None], table.t_kink[a:b, None]
-        l1, l2 = tk - t0, t0 + table.h - tk
-        s = 0.5 * (1.0 + x)[None, :]
-        times = np.concatenate([t0 + l1 * s, tk + l2 * s], axis=1)               # (k, 2 nodes)
-        r0, r1 = table.rate0[a:b, None], table.rate1[a:b, None]
-        al = table.alpha0[a:b, None]
-        alpha = np.concatenate([al + r0 * l1 * s, al + r0 * l1 + r1 * l2 * s], axis=1)
-        rate = np.concatenate([np.broadcast_to(r0, (b - a, nodes)), np.broadcast_to(r1, (b - a, nodes))], axis=1)
-        weights = np.concatenate([l1 * w[None, :], l2 * w[None, :]], axis=1) / (2.0 * table.h)
+        times, alpha, rate, weights = _table_nodes(table, a, b, x, w)
+        weights = weights / table.h
         st = motion.state(times.ravel())
         omega_b, force_b = body_rate_and_force(st)
         k, m = times.shape
