@@ -236,6 +236,10 @@ def statistics(key, result):
                 eps = np.abs([up_gyro_dph(key, r) for r in mine])
                 row.update(eps_u_all_dph=float(np.median(eps)),
                            eps_u_below_dph=float(np.median(eps[v < x])) if np.any(v < x) else None)
+            if v.size > 2:        # how much the up-gyro drift alone orders the draws
+                from scipy.stats import spearmanr
+                eps_all = np.abs([up_gyro_dph(key, r) for r in mine])
+                row["spearman_abs_eps_u"] = float(spearmanr(eps_all, v)[0])
             rows.append(row)
         for better, worse in PAIRS[key]:
             for period in sorted({k[1] for k in data}, key=lambda p: (p is None, p)):
@@ -266,7 +270,7 @@ def histograms(key, result, stats, path):
     metric, unit, scale = METRICS[key][0]
     papers = paper_figures(key)
     data = per_draw(result, metric)
-    periods = sorted({k[1] for k in data}, key=lambda p: (p is None, p), reverse=True)
+    periods = [p for p in (*SEED002_EXPERIMENTS, None) if any(k[1] == p for k in data)]   # exp. 1 on top
     schemes = [s for s in result["campaign"]["grid"]["indexing.scheme"] if any(k[0] == s for k in data)]
     fig, axes = plt.subplots(len(periods), len(schemes), figsize=(3.2 * len(schemes), 2.8 * len(periods)),
                              squeeze=False)
