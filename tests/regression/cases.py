@@ -86,16 +86,15 @@ def inputs(name):
     return cfg, dtheta, dv, table, seq
 
 
-def run(cfg, dtheta, dv, seq):
-    """Every tick's output record (OUTPUT_DTYPE, one per sample), stepping one
-    sample at a time; the encoder reads back the last commanded table angle
-    (an ideal table, as in the embedded demo; the increments do not turn with
-    it: the records test bits, not physics). A rejected sample keeps the
-    record the call wrote."""
-    ffi, lib = native.ffi, native.lib
+def _closed(cfg, dtheta, dv, seq, dtype, step):
+    """Every tick's record of ``dtype``, stepping one sample at a time with
+    ``step(fw, sample)`` (the record it leaves, a cffi pointer); the encoder
+    reads back the last commanded table angle (an ideal table, as in the
+    embedded demo; the increments do not turn with it: the records test
+    bits, not physics)."""
+    ffi = native.ffi
     fw = native.Firmware(cfg)
-    out = np.zeros(len(dtheta), dtype=native.OUTPUT_DTYPE)
-    rec = ffi.new("pyins_output *")
+    out = np.zeros(len(dtheta), dtype=dtype)
     sample = ffi.new("pyins_sample *")
     enc = float(cfg.get("table_angle_rad", 0.0))
     two_pi = 2.0 * np.pi
@@ -105,10 +104,21 @@ def run(cfg, dtheta, dv, seq):
             sample.dv_p_mps[i] = dv[k, i]
         sample.table_angle_rad = enc
         sample.seq = int(seq[k]) & 0xFFFFFFFF
-        lib.pyins_step(fw.core, sample, rec)
-        out[k] = np.frombuffer(ffi.buffer(rec), dtype=native.OUTPUT_DTYPE)[0]
+        rec = step(fw, sample)
+        out[k] = np.frombuffer(ffi.buffer(ffi.addressof(rec), dtype.itemsize), dtype=dtype)[0]
         enc = float(rec.table_angle_cmd_rad) % two_pi
     return out
+
+
+def run(cfg, dtheta, dv, seq):
+    """Every tick's output record (OUTPUT_DTYPE, one per sample) through
+    pyins_step (_closed). A rejected sample keeps the record the call wrote."""
+    rec = native.ffi.new("pyins_output *")
+
+    def step(fw, sample):
+        native.lib.pyins_step(fw.core, sample, rec)
+        return rec[0]
+    return _closed(cfg, dtheta, dv, seq, native.OUTPUT_DTYPE, step)
 
 
 def run_compact(cfg, dtheta, dv, seq):
@@ -117,24 +127,13 @@ def run_compact(cfg, dtheta, dv, seq):
     dropped duplicate) or is rejected writes none: pyins_get_nav then gives
     the state, as pyins_step's record would."""
     ffi, lib = native.ffi, native.lib
-    fw = native.Firmware(cfg)
-    out = np.zeros(len(dtheta), dtype=native.NAV_DTYPE)
     nav = ffi.new("pyins_nav[2]")
-    sample = ffi.new("pyins_sample *")
     n_done = ffi.new("size_t *")
     n_out = ffi.new("size_t *")
-    enc = float(cfg.get("table_angle_rad", 0.0))
-    two_pi = 2.0 * np.pi
-    for k in range(len(dtheta)):
-        for i in range(3):
-            sample.dtheta_p_rad[i] = dtheta[k, i]
-            sample.dv_p_mps[i] = dv[k, i]
-        sample.table_angle_rad = enc
-        sample.seq = int(seq[k]) & 0xFFFFFFFF
+
+    def step(fw, sample):
         lib.pyins_run_nav(fw.core, sample, 1, 1, nav, 2, n_done, n_out)
         if n_out[0] == 0:
             assert lib.pyins_get_nav(fw.core, nav) == 0
-        out[k] = np.frombuffer(ffi.buffer(nav, native.NAV_DTYPE.itemsize), dtype=native.NAV_DTYPE)[0]
-        enc = float(nav[0].table_angle_cmd_rad) % two_pi
-    return out
-
+        return nav[0]
+    return _closed(cfg, dtheta, dv, seq, native.NAV_DTYPE, step)
