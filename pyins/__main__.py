@@ -156,8 +156,8 @@ def _default_out(name):
     return os.path.join("runs", name)
 
 
-def cmd_run(args):
-    scn = scenario.load(args.scenario)
+def _set_overrides(args):
+    """The scenario overrides of --set KEY=VALUE (repeatable) and --hours."""
     overrides = {}
     for item in args.set or []:
         if "=" not in item:
@@ -166,6 +166,12 @@ def cmd_run(args):
         overrides[k.strip()] = _toml_value(v.strip(), f"--set {k.strip()}")
     if args.hours is not None:
         overrides["duration"] = f"{args.hours} h"
+    return overrides
+
+
+def cmd_run(args):
+    scn = scenario.load(args.scenario)
+    overrides = _set_overrides(args)
     if args.seed is not None:
         overrides["seed"] = args.seed
     if overrides:
@@ -412,14 +418,7 @@ def cmd_budget(args):
     source alone through the firmware too (docs/concepts.md, "The error budget")."""
     from pyins import analysis
     scn = scenario.load(args.scenario)
-    overrides = {}
-    for item in args.set or []:
-        if "=" not in item:
-            raise InputError(f"--set {item!r}: expected KEY=VALUE, e.g. --set indexing.scheme=none")
-        k, v = item.split("=", 1)
-        overrides[k.strip()] = _toml_value(v.strip(), f"--set {k.strip()}")
-    if args.hours is not None:
-        overrides["duration"] = f"{args.hours} h"
+    overrides = _set_overrides(args)
     if overrides:
         scn = scn.with_overrides(overrides)
     specs = list(scn.runs())
