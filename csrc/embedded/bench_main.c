@@ -18,10 +18,7 @@
 
 #include "bench_modes.h"
 #include "pyins_core.h"
-
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#include "systick.h"
 
 #ifndef BENCH_TICKS
 #define BENCH_TICKS 3000
@@ -29,36 +26,14 @@
 
 static unsigned char g_mem[16384] __attribute__((aligned(16)));
 
-/* counts between two readings of the 24-bit down-counter */
-static uint32_t elapsed(uint32_t t0, uint32_t t1) { return (t0 - t1) & 0xFFFFFFu; }
-
-#define NOP8 "nop\n nop\n nop\n nop\n nop\n nop\n nop\n nop\n"
-#define NOP64 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8
-
 int main(void) {
     pyins_config cfg;
     pyins_sample s;
     pyins_output out;
-    uint32_t t0, t1, empty = 0xFFFFFFu, nops = 0;
+    uint32_t t0, t1, empty, nops;
     int m, k;
-    SYST_RVR = 0xFFFFFFu;
-    SYST_CVR = 0u;
-    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
-
     /* calibration: the reading itself, and 1024 instructions */
-    for (k = 0; k < 16; ++k) {
-        t0 = SYST_CVR;
-        t1 = SYST_CVR;
-        if (elapsed(t0, t1) < empty) empty = elapsed(t0, t1);
-    }
-    for (k = 0; k < 4; ++k) {
-        t0 = SYST_CVR;
-        __asm volatile(NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64
-                       NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64);
-        t1 = SYST_CVR;
-        nops += elapsed(t0, t1);
-    }
-    printf("CAL nops %d counts %lu empty %lu\n", 4 * 1024, (unsigned long)nops, (unsigned long)empty);
+    systick_calibrate(&nops, &empty);
 
     if (pyins_core_size() > sizeof g_mem) {
         printf("FAIL instance too large\n");

@@ -8,7 +8,7 @@
  * outputs NULL, bench_modes.h's "nav" scenario), and measures what each
  * routine costs on typical operands, with SysTick under QEMU -icount as
  * bench_main.c does. tools/m4f_ops.py runs it and prints the table:
- *   CAL nops <instructions> counts <counts>
+ *   CAL nops <instructions> counts <counts> empty <counts>
  *   OP <name> counts <counts per OP_REPEAT calls, loop included>
  *   NAV ticks <n> counts <counts>
  *   CALLS <name> <calls> ...
@@ -22,14 +22,10 @@
 
 #include "bench_modes.h"
 #include "pyins_core.h"
+#include "systick.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define OP_REPEAT 1000
 #define NAV_TICKS 3000
-
-static uint32_t elapsed(uint32_t t0, uint32_t t1) { return (t0 - t1) & 0xFFFFFFu; }
 
 static unsigned char g_mem[16384] __attribute__((aligned(16)));
 static volatile int g_counting;
@@ -72,33 +68,21 @@ static volatile double g_a = 1.2345678901234567, g_b = 0.98765432109876543, g_si
         t0 = SYST_CVR;                                      \
         for (k = 0; k < OP_REPEAT; ++k) {                   \
             const double a = g_a, b = g_b;                  \
+            (void)b; /* both volatile loads in every loop */ \
             g_sink = (expr);                                \
         }                                                   \
         t1 = SYST_CVR;                                      \
         printf("OP %s counts %lu\n", label, (unsigned long)elapsed(t0, t1)); \
     } while (0)
 
-#define NOP8 "nop\n nop\n nop\n nop\n nop\n nop\n nop\n nop\n"
-#define NOP64 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8 NOP8
-
 int main(void) {
     pyins_config cfg;
     pyins_sample s;
     pyins_output out;
-    uint32_t t0, t1, nops = 0, sum = 0;
+    uint32_t t0, t1, nops, empty, sum = 0;
     long i;
-    int k, m;
-    SYST_RVR = 0xFFFFFFu;
-    SYST_CVR = 0u;
-    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
-    for (k = 0; k < 4; ++k) {
-        t0 = SYST_CVR;
-        __asm volatile(NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64
-                       NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64 NOP64);
-        t1 = SYST_CVR;
-        nops += elapsed(t0, t1);
-    }
-    printf("CAL nops %d counts %lu\n", 4 * 1024, (unsigned long)nops);
+    int m;
+    systick_calibrate(&nops, &empty);
     TIME("loop", a);
     TIME("dmul", a * b);
     TIME("dadd", a + b);
