@@ -42,6 +42,18 @@ Quat quat_normalize(const Quat& q) {
     return Quat{q.w * inv, q.x * inv, q.y * inv, q.z * inv};
 }
 
+Quat quat_renormalize(const Quat& q) {
+    const double n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    if (!(std::fabs(n2 - 1.0) <= kRenormMax)) {  // also a NaN
+        return quat_normalize(q);
+    }
+    double k = 1.5 - 0.5 * n2;
+    if (q.w < 0.0) {
+        k = -k;
+    }
+    return Quat{q.w * k, q.x * k, q.y * k, q.z * k};
+}
+
 Vec3 quat_rotate(const Quat& q, const Vec3& v) {
     const Vec3 r(q.x, q.y, q.z);
     const Vec3 t = 2.0 * cross(r, v);
@@ -82,7 +94,10 @@ Quat rotvec_to_quat(const Vec3& v) {
     const double theta2 = v(0) * v(0) + v(1) * v(1) + v(2) * v(2);
     double c;
     double s;
-    if (theta2 < kRotvecSeries2) {
+    if (theta2 < kRotvecTiny2) {
+        c = 1.0 - theta2 * kCos2;
+        s = 0.5 - theta2 * kSin2;
+    } else if (theta2 < kRotvecSeries2) {
         c = 1.0 - theta2 * (kCos2 - theta2 * (kCos4 - theta2 * kCos6));
         s = 0.5 - theta2 * (kSin2 - theta2 * (kSin4 - theta2 * kSin6));
     } else {
@@ -136,16 +151,29 @@ Mat3 euler_to_mat(const Vec3& euler) {
     return m;
 }
 
-Vec3 mat_to_euler(const Mat3& m) {
-    const double pitch = pmath::atan2(m(2, 1), pmath::sqrt(m(2, 0) * m(2, 0) + m(2, 2) * m(2, 2)));
-    const double roll = pmath::atan2(-m(2, 0), m(2, 2));
-    const double yaw = pmath::atan2(-m(0, 1), m(1, 1));
+namespace {
+
+/// [pitch, roll, yaw] from the five elements of C_b^n they depend on.
+Vec3 euler_of(double c20, double c21, double c22, double c01, double c11) {
+    const double pitch = pmath::atan2(c21, pmath::sqrt(c20 * c20 + c22 * c22));
+    const double roll = pmath::atan2(-c20, c22);
+    const double yaw = pmath::atan2(-c01, c11);
     return Vec3(pitch, roll, yaw);
 }
 
+}  // namespace
+
+Vec3 mat_to_euler(const Mat3& m) { return euler_of(m(2, 0), m(2, 1), m(2, 2), m(0, 1), m(1, 1)); }
+
 Quat euler_to_quat(const Vec3& euler) { return mat_to_quat(euler_to_mat(euler)); }
 
-Vec3 quat_to_euler(const Quat& q) { return mat_to_euler(quat_to_mat(q)); }
+Vec3 quat_to_euler(const Quat& q) {
+    // the five elements of quat_to_mat(q) the angles read, by its expressions
+    // (the same bits as mat_to_euler(quat_to_mat(q)); 4 elements fewer)
+    const double ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
+    return euler_of(2.0 * (q.x * q.z - q.w * q.y), 2.0 * (q.y * q.z + q.w * q.x), ww - xx - yy + zz,
+                    2.0 * (q.x * q.y - q.w * q.z), ww - xx + yy - zz);
+}
 
 Mat3 mat_orthonormalize(const Mat3& m) { return quat_to_mat(mat_to_quat(m)); }
 

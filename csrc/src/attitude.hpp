@@ -18,6 +18,11 @@ namespace pyins::attitude {
 /// any ship motion) the first omitted terms are < 1e-19 relative, far below
 /// an ulp, and every per-tick rotation avoids sqrt, sin, cos and a division.
 inline constexpr double kRotvecSeries2 = 1e-3;
+/// Below this squared angle [rad^2] the series stops at theta^2: the terms
+/// left out, t^4/384 and t^4/3840, are < 2.6e-17, under half an ulp of c
+/// (~1) and of s (~1/2). Every tick's rotation of n (Earth and transport
+/// rate, ~1e-6 rad) and an IMU turning < 1.8 deg/s at 100 Hz take it.
+inline constexpr double kRotvecTiny2 = 1e-7;
 /// Series coefficients: cos(t/2) = 1 - t^2/8 + t^4/384 - t^6/46080,
 /// sin(t/2)/t = 1/2 - t^2/48 + t^4/3840 - t^6/645120.
 inline constexpr double kCos2 = 1.0 / 8.0;
@@ -35,6 +40,14 @@ Quat quat_mul(const Quat& p, const Quat& q);
 Quat quat_conj(const Quat& q);
 /// Unit quaternion with non-negative scalar part.
 Quat quat_normalize(const Quat& q);
+/// quat_normalize for a q that is unit to rounding (a product of unit
+/// quaternions): q (3 - |q|^2) / 2, one Newton step of 1 / sqrt from 1,
+/// whose norm is 1 - (3/4) e^2 for |q|^2 = 1 + e (below an ulp for
+/// |e| <= kRenormMax); a q further from unit goes to quat_normalize. No
+/// square root or division (the Cortex-M4F's two dearest operations).
+Quat quat_renormalize(const Quat& q);
+/// Largest | |q|^2 - 1 | quat_renormalize corrects by its Newton step.
+inline constexpr double kRenormMax = 1e-8;
 /// q v q* for a unit quaternion q (= quat_to_mat(q) v), as the sandwich
 /// product written out: t = 2 r x v, v' = v + w t + r x t, r = [x, y, z]
 /// (30 flops against 45 for the matrix and its product).
@@ -44,7 +57,7 @@ Mat3 quat_to_mat(const Quat& q);
 /// Unit quaternion (w >= 0) from a rotation matrix, Shepperd's method.
 Quat mat_to_quat(const Mat3& m);
 /// Quaternion of a rotation vector. Qin (2014) eq. 9.2.44; series branch
-/// when |v|^2 < kRotvecSeries2.
+/// when |v|^2 < kRotvecSeries2, its first term alone below kRotvecTiny2.
 Quat rotvec_to_quat(const Vec3& v);
 /// Rotation vector of a unit quaternion, angle in [0, pi].
 Vec3 quat_to_rotvec(const Quat& q);

@@ -157,6 +157,7 @@ void pyins_t_strapdown_update(pyins_t_strapdown* s, const double dtheta_p[3], co
     sd.ref_lon = s->lon;
     sd.lat0 = s->lat;  // a state handed in: anchored at its own latitude
     pyins::pmath::sincos(sd.lat0, &sd.sin_lat0, &sd.cos_lat0);
+    sd.terms = pyins::earth::position_terms(s->lat, sd.sin_lat0, sd.cos_lat0, s->height);
     pyins::strapdown::update(sd, v3(dtheta_p), v3(dv_p), dt);
     s->lat = sd.nav.lat;
     s->lon = sd.nav.lon;

@@ -257,7 +257,7 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
     // Velocity and attitude in ib0: dv rotated by C_p^ib0 at the tick start.
     const strapdown::Compensated c = strapdown::compensate(dtheta_p, dv_p, a.hist);
     a.vel_ib0 = a.vel_ib0 + attitude::quat_to_mat(a.quat_ib0_p) * c.dv_p;
-    a.quat_ib0_p = attitude::quat_normalize(
+    a.quat_ib0_p = attitude::quat_renormalize(
         attitude::quat_mul(a.quat_ib0_p, attitude::rotvec_to_quat(c.phi)));
     strapdown::push_history(a.hist, dtheta_p, dv_p, c);
     a.tick = a.tick + 1;

@@ -56,4 +56,42 @@ Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n)
 /// [lat_dot, lon_dot, h_dot] [rad/s, rad/s, m/s]. Qin (2014) eq. 4.1.12.
 Vec3 position_rate(const Earth& earth, const Vec3& vel_n);
 
+/// The Earth terms of one position (latitude L0 and height) in the form a
+/// navigation tick uses them: the radii as inverses, so that the tick
+/// multiplies where earth_at and position_rate divide. The strapdown keeps
+/// them while the position stays near where they were computed
+/// (strapdown.hpp, "Earth terms"); a tick carries the latitude-dependent
+/// ones to its own latitude L = L0 + d to first order in d.
+struct PositionTerms {
+    double lat;            ///< latitude L0 they were computed at [rad]
+    double height;         ///< height they were computed at [m]
+    double inv_rm_h;       ///< 1 / (R_M + h) [1/m]
+    double inv_rn_h;       ///< 1 / (R_N + h) [1/m]
+    double tan_inv_rn_h;   ///< tan L0 / (R_N + h) [1/m]
+    double sec2_inv_rn_h;  ///< its derivative in L: 1 / ((R_N + h) cos^2 L0) [1/m]
+    double inv_rn_h_cos;   ///< 1 / ((R_N + h) cos L0) [1/m]
+    double tan_lat;        ///< tan L0: d/dL of 1 / cos L is tan L / cos L
+    Vec3 omega_ie_n;       ///< Earth rate in n at L0 [rad/s]
+    double gravity;        ///< normal gravity magnitude [m/s^2]
+};
+
+/// The terms at latitude lat (its sine and cosine given) and height. Qin
+/// (2014) eqs. 4.1.7, 4.1.9-4.1.12; TR8350.2 eqs. 4-1, 4-3, with one
+/// 1 / sqrt(1 - e^2 sin^2 L) shared by R_N, R_M and gamma_0.
+/// Precondition: |cos_lat| > 0.
+PositionTerms position_terms(double lat, double sin_lat, double cos_lat, double height);
+
+/// Earth rate at L0 + d, to first order in d: Omega [0, cos L0 - d sin L0,
+/// sin L0 + d cos L0] (Qin (2014) eq. 4.1.9; the d^2 / 2 left out is
+/// < 1e-12 of Omega for |d| <= 1e-6 rad).
+Vec3 earth_rate(const PositionTerms& p, double d);
+
+/// Transport rate omega_en^n = [-vN, vE, vE tan L] / (R + h) (Qin (2014)
+/// eq. 4.1.10) at L0 + d, tan L to first order in d.
+Vec3 transport_rate(const PositionTerms& p, double d, const Vec3& vel_n);
+
+/// [lat_dot, lon_dot, h_dot] (Qin (2014) eq. 4.1.12) at L0 + d, 1 / cos L
+/// to first order in d.
+Vec3 position_rate(const PositionTerms& p, double d, const Vec3& vel_n);
+
 }  // namespace pyins::earth

@@ -799,7 +799,7 @@ void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3
     } else if (mode_ == Mode::kFineAlign) {
         // the best estimate: the propagated attitude corrected by phi^,
         // provisional until the first NIS window has passed
-        q_np = attitude::quat_normalize(
+        q_np = attitude::quat_renormalize(
             attitude::quat_mul(attitude::rotvec_to_quat(fine_phi()), nav.quat_np));
         const int32_t windows = kf_states_ == 12 ? moving_.nis_windows
                                 : (kf_states_ == 8 ? fine8_.nis_windows : fine5_.nis_windows);
@@ -808,7 +808,7 @@ void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3
         }
     }
     *state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
-    const Quat q_nb = attitude::quat_normalize(attitude::quat_mul(q_np, q_pb));
+    const Quat q_nb = attitude::quat_renormalize(attitude::quat_mul(q_np, q_pb));
     quat_np[0] = q_np.w;
     quat_np[1] = q_np.x;
     quat_np[2] = q_np.y;

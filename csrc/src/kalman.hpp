@@ -18,10 +18,17 @@ template <int R, int C>
 using Mat = Eigen::Matrix<double, R, C>;
 
 /// x <- Phi x;  P <- Phi P Phi^T + Qd, symmetrised.
+///
+/// The N x N products are coefficient-based (lazyProduct, each element a dot
+/// product in index order), for every N: from N = 7 on (rows + cols + depth
+/// >= 20) Eigen would choose its blocked matrix kernel, whose code (with a
+/// heap fallback that only inlining at -O3 removes) is several KB of a
+/// Cortex-M7's 64 KiB budget, for 8 x 8 products that need none of it.
 template <int N>
 void predict(Vec<N>& x, Mat<N, N>& p, const Mat<N, N>& phi, const Mat<N, N>& qd) {
     x = phi * x;
-    const Mat<N, N> pp = phi * p * phi.transpose() + qd;
+    const Mat<N, N> phi_p = phi.lazyProduct(p);
+    const Mat<N, N> pp = phi_p.lazyProduct(phi.transpose()) + qd;
     p = 0.5 * (pp + pp.transpose());
 }
 
@@ -45,7 +52,8 @@ double update2(Vec<N>& x, Mat<N, N>& p, const Mat<2, N>& h, const Vec<2>& z, con
     const double nis = nu.dot(s_inv * nu);
     x = x + k * nu;
     const Mat<N, N> ikh = Mat<N, N>::Identity() - k * h;
-    const Mat<N, N> pj = ikh * p * ikh.transpose() + k * r * k.transpose();
+    const Mat<N, N> ikh_p = ikh.lazyProduct(p);
+    const Mat<N, N> pj = ikh_p.lazyProduct(ikh.transpose()) + k * r * k.transpose();
     p = 0.5 * (pj + pj.transpose());
     return nis;
 }

@@ -74,11 +74,23 @@ void lat_sincos(Strapdown& s, double* sin_lat, double* cos_lat) {
     *cos_lat = s.cos_lat0 * cd - s.sin_lat0 * sd;
 }
 
+const earth::PositionTerms& position_terms(Strapdown& s) {
+    if (!(std::fabs(s.nav.lat - s.terms.lat) <= kTermsLatStep &&
+          std::fabs(s.nav.height - s.terms.height) <= kTermsHeightStep)) {  // also a NaN
+        double sin_lat;
+        double cos_lat;
+        lat_sincos(s, &sin_lat, &cos_lat);
+        s.terms = earth::position_terms(s.nav.lat, sin_lat, cos_lat, s.nav.height);
+    }
+    return s.terms;
+}
+
 Strapdown make_strapdown(const NavState& nav, Vertical vertical) {
     Strapdown s;
     s.nav = nav;
     s.lat0 = nav.lat;
     pmath::sincos(s.lat0, &s.sin_lat0, &s.cos_lat0);
+    s.terms = earth::position_terms(nav.lat, s.sin_lat0, s.cos_lat0, nav.height);
     s.hist.dtheta1 = Vec3::Zero();
     s.hist.dv1 = Vec3::Zero();
     s.hist.dtheta2 = Vec3::Zero();
@@ -100,22 +112,33 @@ PYINS_HOT_FLATTEN Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv
     // 1. Coning, sculling and rotation compensation (strapdown.hpp).
     const Compensated c = compensate(dtheta_p, dv_p, s.hist);
 
-    // 2. Earth quantities at the start position with the velocity
-    //    extrapolated to mid-tick (Yan 2019 sec. 4.1.4). The position is not
-    //    extrapolated: half a tick moves a ship < 0.1 m, which changes
-    //    gravity by < 1e-9 m/s^2.
+    // 2. Earth quantities at the start position (the terms kept near it,
+    //    strapdown.hpp) with the velocity extrapolated to mid-tick (Yan 2019
+    //    sec. 4.1.4). The position is not extrapolated: half a tick moves a
+    //    ship < 0.1 m, which changes gravity by < 1e-9 m/s^2.
     const Vec3 vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n;
-    double sin_lat;
-    double cos_lat;
-    lat_sincos(s, &sin_lat, &cos_lat);
-    const earth::Earth e = earth::earth_at(sin_lat, cos_lat, s.nav.height, vel_mid);
+    const earth::PositionTerms& p = position_terms(s);
+    const double d = s.nav.lat - p.lat;   // |d| <= kTermsLatStep
+    const Vec3 omega_ie_n = earth::earth_rate(p, d);
+    const Vec3 omega_en_n = earth::transport_rate(p, d, vel_mid);
+    const Vec3 omega_in_n = omega_ie_n + omega_en_n;
+    double gravity = p.gravity;
+    if (s.vertical == Vertical::kFree) {
+        // a free vertical channel's dynamics are gravity's own feedback:
+        // gravity at this tick's position, exactly (strapdown.hpp)
+        double sin_lat;
+        double cos_lat;
+        lat_sincos(s, &sin_lat, &cos_lat);
+        gravity = earth::normal_gravity(sin_lat, s.nav.height);
+    }
+    const Vec3 gravity_n(0.0, 0.0, -gravity);
 
     // 3. Velocity: specific force rotated into n with the rotation of n over
     //    the tick, then gravity and Coriolis (Yan 2019 eq. 4.1.27).
     const Vec3 dv_n0 = attitude::quat_rotate(s.nav.quat_np, c.dv_p);
-    const Vec3 dv_sf_n = dv_n0 - 0.5 * dt * cross(e.omega_in_n, dv_n0);
-    const Vec3 coriolis_n = cross(2.0 * e.omega_ie_n + e.omega_en_n, vel_mid);
-    const Vec3 dv_cor_n = (e.gravity_n - coriolis_n) * dt;
+    const Vec3 dv_sf_n = dv_n0 - 0.5 * dt * cross(omega_in_n, dv_n0);
+    const Vec3 coriolis_n = cross(2.0 * omega_ie_n + omega_en_n, vel_mid);
+    const Vec3 dv_cor_n = (gravity_n - coriolis_n) * dt;
     Vec3 vel_new = s.nav.vel_n + dv_sf_n + dv_cor_n;
     if (s.vertical == Vertical::kHold) {
         vel_new(2) = 0.0;
@@ -123,7 +146,7 @@ PYINS_HOT_FLATTEN Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv
 
     // 4. Position by the trapezoidal rule (Qin 2014 eq. 4.1.12).
     const Vec3 vel_avg = 0.5 * (s.nav.vel_n + vel_new);
-    const Vec3 pos_rate = earth::position_rate(e, vel_avg);
+    const Vec3 pos_rate = earth::position_rate(p, d, vel_avg);
     s.nav.lat = s.nav.lat + pos_rate(0) * dt;
     double lon = s.nav.lon + pos_rate(1) * dt;
     if (lon > kPi) {
@@ -139,9 +162,9 @@ PYINS_HOT_FLATTEN Vec3 update(Strapdown& s, const Vec3& dtheta_p, const Vec3& dv
     }
 
     // 5. Attitude: q_np(k) = q(-T omega_in^n) q_np(k-1) q(phi) (Yan eq. 4.1.8).
-    const Quat q_nn = attitude::rotvec_to_quat(-dt * e.omega_in_n);
+    const Quat q_nn = attitude::rotvec_to_quat(-dt * omega_in_n);
     const Quat q_pp = attitude::rotvec_to_quat(c.phi);
-    s.nav.quat_np = attitude::quat_normalize(
+    s.nav.quat_np = attitude::quat_renormalize(
         attitude::quat_mul(attitude::quat_mul(q_nn, s.nav.quat_np), q_pp));
 
     // 6. Memory for the next tick.

@@ -23,15 +23,36 @@
 // rectified error of ~1 ug. The first two ticks after init, lacking history,
 // use the lower orders (no correction, then the two-sample 1/12 form).
 //
-// Latitude sine and cosine: the sine and cosine of an anchor latitude L0
-// are kept, and those of L = L0 + d are its angle sums with the series of
-// d: cos d = 1 - d^2/2 + d^4/24, sin d = d - d^3/6 (the next terms, d^6/720
-// and d^5/120, are below 1e-22 for |d| <= kLatAnchorStep: the result is the
-// sine to a few roundings, as pmath::sincos is); the anchor moves to L when
-// |d| would exceed the step (640 m). A dozen operations instead of a
-// reduction and two kernels.
+// Earth terms: the radii, Earth rate and gravity depend on the position
+// alone, which a ship moves by well under a metre a tick. They are kept
+// (earth::PositionTerms, radii as inverses so a tick multiplies where it
+// would divide) and computed again when the latitude has moved more than
+// kTermsLatStep (1e-6 rad, 6.4 m) or the height more than kTermsHeightStep
+// (0.01 m) from where they were. A tick carries the latitude-dependent ones
+// (Earth rate, tan L, 1 / cos L) to its own latitude to first order in
+// d = L - L0 (the d^2 terms left out are < 1e-10 of themselves below
+// 80 deg of latitude): kept
+// as they were, the Earth rate of a latitude 6 cm off tilted a static
+// ship's IMU turning on the table by 1e-9 rad in an hour (2.5 mm), where
+// the exact algorithm leaves 1e-6 m. What stays stale is the radii's
+// dependence on latitude and height, 1e-8 of themselves at most (R_M: 3 e^2
+// sin L cos L per radian; 1 mm of position over 100 km). Gravity is kept only while the vertical channel
+// is held (then it reaches nothing but that clamped channel); a free
+// channel's dynamics are gravity's own feedback (-2 g / R per metre,
+// e-folding in ~570 s), so it takes gravity at each tick's latitude and
+// height: 5e-10 m/s^2 of gravity from a latitude 6 cm stale moved it 8 mm
+// in an hour in the same test, where exact gravity leaves 3e-5 m.
+//
+// Latitude sine and cosine (for those terms): the sine and cosine of an
+// anchor latitude L0 are kept, and those of L = L0 + d are its angle sums
+// with the series of d: cos d = 1 - d^2/2 + d^4/24, sin d = d - d^3/6 (the
+// next terms, d^6/720 and d^5/120, are below 1e-22 for |d| <=
+// kLatAnchorStep: the result is the sine to a few roundings, as
+// pmath::sincos is); the anchor moves to L when |d| would exceed the step
+// (640 m). A dozen operations instead of a reduction and two kernels.
 #pragma once
 
+#include "earth.hpp"
 #include "types.hpp"
 
 namespace pyins::strapdown {
@@ -64,6 +85,10 @@ struct History {
 /// Everything the update carries from one tick to the next.
 /// Largest |lat - anchor| before the anchor moves [rad] (640 m).
 inline constexpr double kLatAnchorStep = 1.0e-4;
+/// Largest latitude move before the Earth terms are computed again [rad] (6.4 m).
+inline constexpr double kTermsLatStep = 1.0e-6;
+/// Largest height move before the Earth terms are computed again [m].
+inline constexpr double kTermsHeightStep = 0.01;
 
 struct Strapdown {
     NavState nav;
@@ -71,6 +96,7 @@ struct Strapdown {
     double lat0;          ///< the anchor latitude [rad]
     double sin_lat0;      ///< its sine and cosine (pmath::sincos)
     double cos_lat0;
+    earth::PositionTerms terms;   ///< the Earth terms near nav's position
     Vec3 prev_dvel_n;     ///< v(k-1) - v(k-2), for the mid-tick velocity [m/s]
     Vertical vertical;
     double ref_height;    ///< height held in kHold mode [m]
@@ -113,6 +139,10 @@ History history_of(const Vec3& dtheta1, const Vec3& dv1, const Vec3& dtheta2, co
 
 /// Sine and cosine of s.nav.lat from the anchor (moved when too far).
 void lat_sincos(Strapdown& s, double* sin_lat, double* cos_lat);
+
+/// The Earth terms at s.nav's position: those kept, or computed again when
+/// the position has moved more than kTermsLatStep / kTermsHeightStep.
+const earth::PositionTerms& position_terms(Strapdown& s);
 
 /// Start a strapdown at a navigation state.
 Strapdown make_strapdown(const NavState& nav, Vertical vertical);

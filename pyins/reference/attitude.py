@@ -25,6 +25,7 @@ import numpy as np
 #: theta^6 (attitude.hpp: kRotvecSeries2). At theta^2 = 1e-3 (31.6 mrad, 181
 #: deg/s at 100 Hz) the first omitted terms are < 1e-19 relative.
 ROTVEC_SERIES2 = 1e-3
+ROTVEC_TINY2 = 1e-7    #: kRotvecTiny2: below it the series' first term alone
 COS2, COS4, COS6 = 1.0 / 8.0, 1.0 / 384.0, 1.0 / 46080.0      #: kCos2, kCos4, kCos6
 SIN2, SIN4, SIN6 = 1.0 / 48.0, 1.0 / 3840.0, 1.0 / 645120.0   #: kSin2, kSin4, kSin6
 
@@ -68,6 +69,22 @@ def quat_normalize(q):
         n = -n
     inv = 1.0 / n
     return np.array([q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv])
+
+
+RENORM_MAX = 1e-8   #: kRenormMax
+
+
+def quat_renormalize(q):
+    """quat_normalize for a q unit to rounding: q (3 - |q|^2) / 2, one
+    Newton step of 1 / sqrt from 1 (mirrors pyins::attitude::quat_renormalize;
+    attitude.hpp gives the error); further from unit, quat_normalize."""
+    n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]
+    if not abs(n2 - 1.0) <= RENORM_MAX:
+        return quat_normalize(q)
+    k = 1.5 - 0.5 * n2
+    if q[0] < 0.0:
+        k = -k
+    return np.array([q[0] * k, q[1] * k, q[2] * k, q[3] * k])
 
 
 def quat_rotate(q, v):
@@ -121,10 +138,14 @@ def rotvec_to_quat(v):
     """Quaternion of the rotation vector v (Qin 2014 eq. 9.2.44).
 
     Small-angle branch: Taylor series of cos(theta/2) and sin(theta/2)/theta
-    to theta^6 (Horner form) when theta^2 < ROTVEC_SERIES2.
+    to theta^6 (Horner form) when theta^2 < ROTVEC_SERIES2, to theta^2 when
+    theta^2 < ROTVEC_TINY2 (what it leaves out is under half an ulp).
     """
     theta2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-    if theta2 < ROTVEC_SERIES2:
+    if theta2 < ROTVEC_TINY2:
+        c = 1.0 - theta2 * COS2
+        s = 0.5 - theta2 * SIN2
+    elif theta2 < ROTVEC_SERIES2:
         c = 1.0 - theta2 * (COS2 - theta2 * (COS4 - theta2 * COS6))
         s = 0.5 - theta2 * (SIN2 - theta2 * (SIN4 - theta2 * SIN6))
     else:
@@ -186,9 +207,15 @@ def mat_to_euler(m):
     At exactly +-90 deg pitch roll and yaw are not separable; the formulas then
     return what atan2(0, 0) gives.
     """
-    pitch = np.arctan2(m[2, 1], np.sqrt(m[2, 0] * m[2, 0] + m[2, 2] * m[2, 2]))
-    roll = np.arctan2(-m[2, 0], m[2, 2])
-    yaw = np.arctan2(-m[0, 1], m[1, 1])
+    return _euler_of(m[2, 0], m[2, 1], m[2, 2], m[0, 1], m[1, 1])
+
+
+def _euler_of(c20, c21, c22, c01, c11):
+    """[pitch, roll, yaw] from the five elements of C_b^n they depend on
+    (mirrors euler_of in attitude.cpp)."""
+    pitch = np.arctan2(c21, np.sqrt(c20 * c20 + c22 * c22))
+    roll = np.arctan2(-c20, c22)
+    yaw = np.arctan2(-c01, c11)
     return np.array([pitch, roll, yaw])
 
 
@@ -197,7 +224,13 @@ def euler_to_quat(euler):
 
 
 def quat_to_euler(q):
-    return mat_to_euler(quat_to_mat(q))
+    """The five elements of quat_to_mat(q) the angles read, by its
+    expressions (mirrors quat_to_euler: the same values as
+    mat_to_euler(quat_to_mat(q)))."""
+    w, x, y, z = q
+    ww, xx, yy, zz = w * w, x * x, y * y, z * z
+    return _euler_of(2.0 * (x * z - w * y), 2.0 * (y * z + w * x), ww - xx - yy + zz,
+                     2.0 * (x * y - w * z), ww - xx + yy - zz)
 
 
 def mat_orthonormalize(m):

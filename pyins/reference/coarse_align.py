@@ -234,7 +234,7 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
     c = strapdown.compensate(dtheta_p, dv_p, a.hist)
     phi, dv_comp = c.phi, c.dv_p
     a.vel_ib0 = a.vel_ib0 + attitude.quat_to_mat(a.quat_ib0_p) @ dv_comp
-    a.quat_ib0_p = attitude.quat_normalize(
+    a.quat_ib0_p = attitude.quat_renormalize(
         attitude.quat_mul(a.quat_ib0_p, attitude.rotvec_to_quat(phi)))
     strapdown.push_history(a.hist, dtheta_p, dv_p, c)
     a.tick = a.tick + 1

@@ -96,8 +96,71 @@ def earth_at(sin_lat, cos_lat, height, vel_n):
 def position_rate(earth, vel_n):
     """Rates of latitude, longitude [rad/s] and height [m/s].
 
-    Mirrors ``pyins::earth::position_rate``. Qin (2014) eq. 4.1.12.
+    Mirrors ``pyins::earth::position_rate`` of an `Earth` (that of
+    `PositionTerms` is `position_rate_of_terms`). Qin (2014) eq. 4.1.12.
     """
     lat_dot = vel_n[1] / earth.rm_h
     lon_dot = vel_n[0] / (earth.rn_h * earth.cos_lat)
     return np.array([lat_dot, lon_dot, vel_n[2]])
+
+
+@dataclass
+class PositionTerms:
+    """The Earth terms of one position (latitude L0, height), radii as
+    inverses (mirrors ``pyins::earth::PositionTerms``; strapdown keeps them
+    near the position, a tick carries them to its latitude L0 + d)."""
+    lat: float               #: latitude L0 they were computed at [rad]
+    height: float            #: height they were computed at [m]
+    inv_rm_h: float          #: 1 / (R_M + h) [1/m]
+    inv_rn_h: float          #: 1 / (R_N + h) [1/m]
+    tan_inv_rn_h: float      #: tan L0 / (R_N + h) [1/m]
+    sec2_inv_rn_h: float     #: its derivative in L: 1 / ((R_N + h) cos^2 L0) [1/m]
+    inv_rn_h_cos: float      #: 1 / ((R_N + h) cos L0) [1/m]
+    tan_lat: float           #: tan L0
+    omega_ie_n: np.ndarray   #: Earth rate in n at L0 [rad/s]
+    gravity: float           #: normal gravity magnitude [m/s^2]
+
+
+def position_terms(lat, sin_lat, cos_lat, height):
+    """The terms at one latitude (its sine and cosine given) and height
+    (mirrors ``pyins::earth::position_terms``: four divisions where
+    principal_radii, normal_gravity and earth_at make seven). Qin (2014)
+    eqs. 4.1.7, 4.1.9-4.1.12; TR8350.2 eqs. 4-1, 4-3."""
+    s2 = sin_lat * sin_lat
+    x = 1.0 - E2 * s2
+    inv_sqrt_x = 1.0 / np.sqrt(x)
+    rn = A * inv_sqrt_x                                 # a / sqrt(x)
+    rm = rn * (1.0 - E2) * (inv_sqrt_x * inv_sqrt_x)    # a (1 - e^2) / x^(3/2)
+    gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) * inv_sqrt_x
+    c1 = 2.0 / A * (1.0 + F + M_GRAV - 2.0 * F * s2)
+    c2 = 3.0 / (A * A)
+    inv_cos = 1.0 / cos_lat
+    inv_rm_h = 1.0 / (rm + height)
+    inv_rn_h = 1.0 / (rn + height)
+    tan_lat = sin_lat * inv_cos
+    inv_rn_h_cos = inv_rn_h * inv_cos
+    return PositionTerms(lat=lat, height=height, inv_rm_h=inv_rm_h, inv_rn_h=inv_rn_h,
+                         tan_inv_rn_h=tan_lat * inv_rn_h, sec2_inv_rn_h=inv_rn_h_cos * inv_cos,
+                         inv_rn_h_cos=inv_rn_h_cos, tan_lat=tan_lat,
+                         omega_ie_n=np.array([0.0, OMEGA_IE * cos_lat, OMEGA_IE * sin_lat]),
+                         gravity=gamma0 * (1.0 - c1 * height + c2 * height * height))
+
+
+def earth_rate(p, d):
+    """Earth rate at L0 + d to first order in d (mirrors
+    ``pyins::earth::earth_rate``; Qin (2014) eq. 4.1.9)."""
+    return np.array([0.0, p.omega_ie_n[1] - d * p.omega_ie_n[2], p.omega_ie_n[2] + d * p.omega_ie_n[1]])
+
+
+def transport_rate(p, d, vel_n):
+    """omega_en^n at L0 + d, tan L to first order in d (mirrors
+    ``pyins::earth::transport_rate``; Qin (2014) eq. 4.1.10)."""
+    return np.array([-vel_n[1] * p.inv_rm_h, vel_n[0] * p.inv_rn_h,
+                     vel_n[0] * (p.tan_inv_rn_h + d * p.sec2_inv_rn_h)])
+
+
+def position_rate_of_terms(p, d, vel_n):
+    """[lat_dot, lon_dot, h_dot] at L0 + d, 1 / cos L to first order in d
+    (mirrors ``pyins::earth::position_rate`` of PositionTerms; Qin (2014)
+    eq. 4.1.12)."""
+    return np.array([vel_n[1] * p.inv_rm_h, vel_n[0] * (p.inv_rn_h_cos * (1.0 + d * p.tan_lat)), vel_n[2]])

@@ -565,13 +565,13 @@ class Firmware:
             q_np = attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse))
             valid = False   # provisional until the alignment ends and its wander test passed
         elif self.mode == abi.PYINS_MODE_FINE_ALIGN:
-            q_np = attitude.quat_normalize(
+            q_np = attitude.quat_renormalize(
                 attitude.quat_mul(attitude.rotvec_to_quat(self.fine_phi()), nav.quat_np))
             if ((self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0)
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
         state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
-        q_nb = attitude.quat_normalize(attitude.quat_mul(q_np, q_pb))
+        q_nb = attitude.quat_renormalize(attitude.quat_mul(q_np, q_pb))
         return lat, lon, height, vel, q_np.copy(), q_nb, state_flags
 
     def nav_record(self):

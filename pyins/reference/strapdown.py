@@ -22,6 +22,8 @@ C3_FAR = -31.0 / 720.0       #: kC3Far, (k-2) x (k)
 C3_PAST = 1.0 / 720.0        #: kC3Past, (k-2) x (k-1)
 ONE_SIXTH = 1.0 / 6.0        #: kOneSixth
 LAT_ANCHOR_STEP = 1.0e-4     #: kLatAnchorStep [rad] (640 m)
+TERMS_LAT_STEP = 1.0e-6      #: kTermsLatStep [rad] (6.4 m)
+TERMS_HEIGHT_STEP = 0.01     #: kTermsHeightStep [m]
 
 
 def _zeros():
@@ -71,6 +73,7 @@ class Strapdown:
     lat0: float = None          #: the anchor latitude (None: none yet) [rad]
     sin_lat0: float = 0.0
     cos_lat0: float = 1.0
+    terms: earth.PositionTerms = None   #: the Earth terms near nav's position
 
 
 class Compensated(NamedTuple):
@@ -131,12 +134,25 @@ def lat_sincos(s):
     return s.sin_lat0 * cd + s.cos_lat0 * sd, s.cos_lat0 * cd - s.sin_lat0 * sd
 
 
+def position_terms(s):
+    """The Earth terms at s.nav's position: those kept, or computed again
+    when it has moved more than TERMS_LAT_STEP / TERMS_HEIGHT_STEP (mirrors
+    ``pyins::strapdown::position_terms``; strapdown.hpp says why)."""
+    t = s.terms
+    if t is None or not (abs(s.nav.lat - t.lat) <= TERMS_LAT_STEP
+                         and abs(s.nav.height - t.height) <= TERMS_HEIGHT_STEP):
+        sin_lat, cos_lat = lat_sincos(s)
+        s.terms = earth.position_terms(s.nav.lat, sin_lat, cos_lat, s.nav.height)
+    return s.terms
+
+
 def make_strapdown(nav, vertical):
     s = Strapdown(nav=NavState(nav.lat, nav.lon, nav.height,
                                np.array(nav.vel_n, dtype=float),
                                np.array(nav.quat_np, dtype=float)),
                   vertical=vertical, ref_height=nav.height, ref_lon=nav.lon,
                   lat0=nav.lat, sin_lat0=np.sin(nav.lat), cos_lat0=np.cos(nav.lat))
+    s.terms = earth.position_terms(nav.lat, s.sin_lat0, s.cos_lat0, nav.height)
     if vertical == VERTICAL_HOLD:
         s.nav.vel_n[2] = 0.0
     return s
@@ -151,23 +167,34 @@ def update(s, dtheta_p, dv_p, dt):
     c = compensate(dtheta_p, dv_p, s.hist)
     phi, dv_comp = c.phi, c.dv_p
 
-    # 2. Earth at the start position, velocity extrapolated to mid-tick.
+    # 2. Earth at the start position (the terms kept near it), velocity
+    #    extrapolated to mid-tick.
     vel_mid = s.nav.vel_n + 0.5 * s.prev_dvel_n
-    sin_lat, cos_lat = lat_sincos(s)
-    e = earth.earth_at(sin_lat, cos_lat, s.nav.height, vel_mid)
+    p = position_terms(s)
+    d = s.nav.lat - p.lat   # |d| <= TERMS_LAT_STEP
+    omega_ie_n = earth.earth_rate(p, d)
+    omega_en_n = earth.transport_rate(p, d, vel_mid)
+    omega_in_n = omega_ie_n + omega_en_n
+    gravity = p.gravity
+    if s.vertical == VERTICAL_FREE:
+        # a free vertical channel's dynamics are gravity's own feedback:
+        # gravity at this tick's position, exactly (strapdown.hpp)
+        sin_lat, _ = lat_sincos(s)
+        gravity = earth.normal_gravity(sin_lat, s.nav.height)
+    gravity_n = np.array([0.0, 0.0, -gravity])
 
     # 3. Velocity (Yan 2019 eq. 4.1.27).
     dv_n0 = attitude.quat_rotate(s.nav.quat_np, dv_comp)
-    dv_sf_n = dv_n0 - 0.5 * dt * cross(e.omega_in_n, dv_n0)
-    coriolis_n = cross(2.0 * e.omega_ie_n + e.omega_en_n, vel_mid)
-    dv_cor_n = (e.gravity_n - coriolis_n) * dt
+    dv_sf_n = dv_n0 - 0.5 * dt * cross(omega_in_n, dv_n0)
+    coriolis_n = cross(2.0 * omega_ie_n + omega_en_n, vel_mid)
+    dv_cor_n = (gravity_n - coriolis_n) * dt
     vel_new = s.nav.vel_n + dv_sf_n + dv_cor_n
     if s.vertical == VERTICAL_HOLD:
         vel_new[2] = 0.0
 
     # 4. Position, trapezoidal rule (Qin 2014 eq. 4.1.12).
     vel_avg = 0.5 * (s.nav.vel_n + vel_new)
-    pos_rate = earth.position_rate(e, vel_avg)
+    pos_rate = earth.position_rate_of_terms(p, d, vel_avg)
     s.nav.lat = s.nav.lat + pos_rate[0] * dt
     lon = s.nav.lon + pos_rate[1] * dt
     if lon > np.pi:
@@ -181,9 +208,9 @@ def update(s, dtheta_p, dv_p, dt):
         s.nav.height = s.nav.height + pos_rate[2] * dt
 
     # 5. Attitude: q_np(k) = q(-T omega_in^n) q_np(k-1) q(phi) (Yan eq. 4.1.8).
-    q_nn = attitude.rotvec_to_quat(-dt * e.omega_in_n)
+    q_nn = attitude.rotvec_to_quat(-dt * omega_in_n)
     q_pp = attitude.rotvec_to_quat(phi)
-    s.nav.quat_np = attitude.quat_normalize(
+    s.nav.quat_np = attitude.quat_renormalize(
         attitude.quat_mul(attitude.quat_mul(q_nn, s.nav.quat_np), q_pp))
 
     # 6. Memory for the next tick.
