@@ -101,19 +101,32 @@ int run_every(pyins_core* core, const pyins_sample* samples, size_t n, size_t ou
     size_t written = 0;
     // the next multiple of out_every after the current tick
     uint64_t next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
-    for (size_t i = 0; i < n; ++i) {
-        if (written == out_capacity &&
-            static_cast<uint64_t>(fw->tick() + fw->ticks_for(samples[i])) >= next) {
-            // seq gaps passed more multiples than n / out_every + 1: stop
-            // before the step whose record has no room
-            return PYINS_E_BUFFER_TOO_SMALL;
-        }
-        const int s = fw->step(samples[i], nullptr);
-        if (s < 0) {
-            return s;
+    for (size_t i = 0; i < n;) {
+        // the plain ticks before the next record (Firmware::run_plain), in
+        // one loop; one tick short of it when its record has no room (a
+        // record every tick leaves no run to take: step() at once)
+        const uint64_t stop = written == out_capacity ? next - 1u : next;
+        const size_t k = every == 1u ? 0u
+                         : fw->run_plain(samples + i, n - i,
+                                         stop > static_cast<uint64_t>(INT64_MAX) ? INT64_MAX
+                                                                                 : static_cast<int64_t>(stop));
+        if (k > 0u) {
+            i = i + k;
+        } else {
+            if (written == out_capacity &&
+                static_cast<uint64_t>(fw->tick() + fw->ticks_for(samples[i])) >= next) {
+                // seq gaps passed more multiples than n / out_every + 1: stop
+                // before the step whose record has no room
+                return PYINS_E_BUFFER_TOO_SMALL;
+            }
+            const int s = fw->step(samples[i], nullptr);
+            if (s < 0) {
+                return s;
+            }
+            i = i + 1u;
         }
         if (n_done != nullptr) {
-            *n_done = i + 1u;
+            *n_done = i;
         }
         // a multiple of out_every reached (or passed by a bridged gap)
         if (static_cast<uint64_t>(fw->tick()) >= next) {
@@ -213,13 +226,25 @@ int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
         return PYINS_E_NULL;
     }
     Firmware* fw = const_cast<Firmware*>(cfw);
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < n;) {
+        if (outputs == nullptr) {
+            // no records: the plain ticks in one loop (Firmware::run_plain)
+            const size_t k = fw->run_plain(samples + i, n - i, INT64_MAX);
+            if (k > 0u) {
+                i = i + k;
+                if (n_done != nullptr) {
+                    *n_done = i;
+                }
+                continue;
+            }
+        }
         const int s = fw->step(samples[i], outputs != nullptr ? &outputs[i] : nullptr);
         if (s < 0) {  // rejected; PYINS_W_* notices go on (the records carry them)
             return s;
         }
+        i = i + 1u;
         if (n_done != nullptr) {
-            *n_done = i + 1u;
+            *n_done = i;
         }
     }
     return PYINS_OK;

@@ -564,7 +564,7 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     // length). The reading is taken: the navigation of frame p does not use
     // it, and one tick cannot tell a glitch from a slipped encoder; the
     // indexing machine goes to FAULT (command 0) until pyins_index_reset.
-    if (mode_ != Mode::kIdle && !resync &&
+    if (encoder != encoder_ && mode_ != Mode::kIdle && !resync &&
         std::fabs(wrap_pi(encoder - encoder_)) >
             cfg_.index_jump_rad * static_cast<double>(missing + 1u)) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ENCODER_JUMP);
@@ -600,6 +600,34 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     return status;
 }
 
+size_t Firmware::run_plain(const pyins_sample* samples, size_t n, int64_t tick_end) {
+    if (mode_ != Mode::kNavigate || gap_pending_) {
+        return 0u;
+    }
+    const bool check_seq = cfg_.seq_mode == PYINS_SEQ_CHECK;
+    size_t i = 0u;
+    while (i < n && tick_ < tick_end) {
+        // step()'s tests on a sample it takes as the next tick, in its order
+        const pyins_sample& sample = samples[i];
+        if (!usable(sample) || (check_seq && seq_valid_ && sample.seq - seq_ != 1u)) {
+            break;
+        }
+        const double encoder = wrap_two_pi(sample.table_angle_rad);
+        if (encoder != encoder_ && std::fabs(wrap_pi(encoder - encoder_)) > cfg_.index_jump_rad) {
+            break;
+        }
+        const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
+        const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
+        advance(dtheta_p, dv_p, encoder);
+        last_dtheta_ = dtheta_p;
+        last_dv_ = dv_p;
+        seq_ = sample.seq;
+        seq_valid_ = true;
+        i = i + 1u;
+    }
+    return i;
+}
+
 void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     // Linear interpolation between the last sample taken and this one (the
     // missing ticks lie between them, and both are at hand when the gap is
@@ -627,12 +655,13 @@ void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, d
 
 PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
     // 1. Unwrap the encoder: the table turns far less than pi per tick.
-    const double dalpha = wrap_pi(encoder - encoder_);
-    table_angle_ = table_angle_ + dalpha;
+    double dalpha = 0.0;
     if (encoder != encoder_) {  // the table moved: refresh the cached half-angle
+        dalpha = wrap_pi(encoder - encoder_);
         encoder_ = encoder;
         pmath::sincos(0.5 * encoder_, &enc_sin_half_, &enc_cos_half_);
     }
+    table_angle_ = table_angle_ + dalpha;
     // 2. Lever arm: w(t0) refined on the second tick, the rates of this one.
     if (has_lever_ != 0) {
         if (lever_refine_ != 0) {

@@ -67,6 +67,15 @@ class Firmware {
     /// Returns PYINS_OK, a PYINS_W_* notice or a negative status.
     int step(const pyins_sample& sample, pyins_output* out);
 
+    /// step() without records for samples[0..n), up to the first that is
+    /// not a plain tick or until tick() reaches tick_end; returns how many
+    /// it took. Plain: in NAVIGATE (no alignment restart pending), a usable
+    /// sample, the next seq (or seq not checked), the encoder within its
+    /// jump limit: step() on it takes no branch but the tick's. The state
+    /// after it is step()'s, bit for bit, without step()'s per-sample
+    /// dispatch; the caller steps the sample that stopped it.
+    size_t run_plain(const pyins_sample* samples, size_t n, int64_t tick_end);
+
     /// How many ticks stepping this sample would add to tick() (0: it would
     /// be rejected or dropped). Changes nothing.
     int64_t ticks_for(const pyins_sample& sample) const;

@@ -418,7 +418,7 @@ class Firmware:
         dtheta_p = np.array(dtheta_p, dtype=float)
         dv_p = np.array(dv_p, dtype=float)
         encoder = wrap_two_pi(table_angle_rad)
-        if (self.mode != abi.PYINS_MODE_IDLE and not resync
+        if (encoder != self.encoder and self.mode != abi.PYINS_MODE_IDLE and not resync
                 and abs(wrap_pi(encoder - self.encoder)) > self.cfg["index_jump_rad"] * float(missing + 1)):
             self.faults = self.faults | abi.PYINS_FAULT_ENCODER_JUMP
             self.counts["n_encoder_jumps"] = count(self.counts["n_encoder_jumps"])
@@ -459,12 +459,13 @@ class Firmware:
     def advance(self, dtheta_p, dv_p, encoder):
         """One tick with increments taken as good (mirrors Firmware::advance)."""
         # 1. Unwrap the encoder: the table turns far less than pi per tick.
-        dalpha = wrap_pi(encoder - self.encoder)
-        self.table_angle = self.table_angle + dalpha
+        dalpha = 0.0
         if encoder != self.encoder:   # the table moved: refresh the cached half-angle
+            dalpha = wrap_pi(encoder - self.encoder)
             self.encoder = encoder
             self.enc_sin_half = math.sin(0.5 * self.encoder)
             self.enc_cos_half = math.cos(0.5 * self.encoder)
+        self.table_angle = self.table_angle + dalpha
         # 2. Lever arm: w(t0) refined on the second tick, the rates of this one.
         if self.has_lever:
             if self.lever_refine:
