@@ -31,6 +31,10 @@ Quat quat_mul(const Quat& p, const Quat& q) {
     };
 }
 
+Quat quat_mul_z(const Quat& p, double c, double s) {
+    return Quat{p.w * c - p.z * s, p.x * c + p.y * s, p.y * c - p.x * s, p.w * s + p.z * c};
+}
+
 Quat quat_conj(const Quat& q) { return Quat{q.w, -q.x, -q.y, -q.z}; }
 
 Quat quat_normalize(const Quat& q) {

@@ -144,8 +144,8 @@ void Firmware::start_navigation() {
 }
 
 void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
-    const Quat q_pb{enc_cos_half_, 0.0, 0.0, -enc_sin_half_};
-    const Quat q_nb = attitude::quat_mul(sd_.nav.quat_np, q_pb);
+    // q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]
+    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
     // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler): its cosine
     // and sine are C11 / h and -C01 / h, h = |(C01, C11)| (no angle taken)
     const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
@@ -816,7 +816,6 @@ void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3
 
     // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
     // measured (encoder) angle: q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)].
-    const Quat q_pb{enc_cos_half_, 0.0, 0.0, -enc_sin_half_};
     Quat q_np = nav.quat_np;
     bool valid = att_valid_;
     if (mode_ == Mode::kCoarseAlign && coarse_.solved) {
@@ -837,7 +836,7 @@ void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3
         }
     }
     *state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
-    const Quat q_nb = attitude::quat_renormalize(attitude::quat_mul(q_np, q_pb));
+    const Quat q_nb = attitude::quat_renormalize(attitude::quat_mul_z(q_np, enc_cos_half_, -enc_sin_half_));
     quat_np[0] = q_np.w;
     quat_np[1] = q_np.x;
     quat_np[2] = q_np.y;

@@ -58,6 +58,12 @@ def quat_mul(p, q):
     ])
 
 
+def quat_mul_z(p, c, s):
+    """quat_mul(p, [c, 0, 0, s]) without the terms multiplied by zero
+    (mirrors pyins::attitude::quat_mul_z)."""
+    return np.array([p[0] * c - p[3] * s, p[1] * c + p[2] * s, p[2] * c - p[1] * s, p[0] * s + p[3] * c])
+
+
 def quat_conj(q):
     return np.array([q[0], -q[1], -q[2], -q[3]])
 

@@ -143,8 +143,8 @@ class Firmware:
     def imu_yaw_sincos(self):
         """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors
         Firmware::imu_yaw_sincos)."""
-        q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
-        w, x, y, z = attitude.quat_mul(self.sd.nav.quat_np, q_pb)
+        # q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]
+        w, x, y, z = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
         c01 = 2.0 * (x * y - w * z)
         c11 = w * w - x * x + y * y - z * z
         h = np.sqrt(c01 * c01 + c11 * c11)
@@ -559,7 +559,6 @@ class Firmware:
             lat, lon, height, vel = self.reference_point()
             if self.sd.vertical == strapdown.VERTICAL_HOLD:
                 vel[2] = 0.0
-        q_pb = np.array([self.enc_cos_half, 0.0, 0.0, -self.enc_sin_half])
         q_np = nav.quat_np
         valid = self.att_valid
         if self.mode == abi.PYINS_MODE_COARSE_ALIGN and self.coarse.solved:
@@ -572,7 +571,7 @@ class Firmware:
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
         state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
-        q_nb = attitude.quat_renormalize(attitude.quat_mul(q_np, q_pb))
+        q_nb = attitude.quat_renormalize(attitude.quat_mul_z(q_np, self.enc_cos_half, -self.enc_sin_half))
         return lat, lon, height, vel, q_np.copy(), q_nb, state_flags
 
     def nav_record(self):

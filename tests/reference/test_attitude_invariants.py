@@ -93,10 +93,12 @@ def test_heading_and_yaw():
     assert attitude.yaw_to_heading(1e-15) == 2 * np.pi - 1e-15
 
 
-@given(angle=st.floats(1e-4, np.sqrt(attitude.ROTVEC_SERIES2)), u=unit_vectors())
+@given(angle=st.floats(1e-9, np.sqrt(attitude.ROTVEC_SERIES2)), u=unit_vectors())
 def test_rotvec_series_branch_equals_closed_form(angle, u):
-    """The Taylor branch must agree with cos/sin to 1 ulp (2.2e-16) where it
-    is used, or the switch would put a step into the attitude."""
+    """The Taylor branches (to theta^6, and to theta^2 alone below
+    ROTVEC_TINY2, where a tick's rotation of n always is) must agree with
+    cos/sin to 1 ulp (2.2e-16) where they are used, or a switch would put a
+    step into the attitude."""
     v = u * angle
     half = 0.5 * angle
     closed = np.concatenate([[np.cos(half)], np.sin(half) / angle * v])
@@ -118,3 +120,33 @@ def test_coarse_triad_is_a_rotation_and_exact_without_noise(q, v1, v2, noise):
     assert_allclose(exact, c, rtol=0, atol=1e-13)   # conditioning of the pair, >= 1e-2
     noisy = coarse_align.solve_mat_i_ib0(c @ v1 + noise, c @ v2 - noise, v1, v2)
     _proper_rotation(noisy)
+
+
+@given(q=quaternions(), angle=st.floats(-np.pi, np.pi))
+def test_quat_mul_z_is_quat_mul_bit_for_bit(q, angle):
+    """The record's ship attitude q_np [c, 0, 0, s] by the product without
+    its zero terms: the same bits as the full product for finite nonzero
+    components (the golden records depend on it)."""
+    c, s = np.cos(0.5 * angle), np.sin(0.5 * angle)
+    full = attitude.quat_mul(q, np.array([c, 0.0, 0.0, s]))
+    short = attitude.quat_mul_z(q, c, s)
+    nonzero = full != 0.0
+    assert full[nonzero].tobytes() == short[nonzero].tobytes()
+    assert np.all(short[~nonzero] == 0.0)
+
+
+@given(q=quaternions(), e=st.floats(-1e-8, 1e-8), far=st.floats(1e-7, 0.5))
+def test_quat_renormalize_is_exact_near_unit_and_normalizes_far_from_it(q, e, far):
+    """One Newton step from |q|^2 = 1 + e leaves |q|^2 - 1 ~ 3 e^2 / 4: for
+    |e| <= 1e-8 (the renormalised quaternion is a product of unit ones, e ~
+    1e-15) as near unit as quat_normalize's result and within 2 ulps of it;
+    further from unit it is quat_normalize."""
+    near = q * np.sqrt(1.0 + e)
+    r = attitude.quat_renormalize(near)
+    n = attitude.quat_normalize(near)
+    # |r|^2 as far from 1 as the divided one's, to 2 ulps (4.4e-16: the
+    # sum of four squares rounds too)
+    assert abs(np.dot(r, r) - 1.0) <= abs(np.dot(n, n) - 1.0) + 4.5e-16
+    assert_allclose(r, n, rtol=0, atol=4.5e-16)
+    q_far = q * np.sqrt(1.0 + far)
+    assert attitude.quat_renormalize(q_far).tobytes() == attitude.quat_normalize(q_far).tobytes()
