@@ -13,12 +13,21 @@ PrincipalRadii principal_radii(double sin_lat) {
     return {rm, rn};
 }
 
-double normal_gravity(double sin_lat, double height) {
-    const double s2 = sin_lat * sin_lat;
-    const double gamma0 = kGammaE * (1.0 + kSomigliana * s2) / pmath::sqrt(1.0 - kE2 * s2);
+namespace {
+
+/// gamma0 at height h, s2 = sin^2 L (TR8350.2 eq. 4-3).
+double at_height(double gamma0, double s2, double height) {
     const double c1 = 2.0 / kA * (1.0 + kF + kMGrav - 2.0 * kF * s2);
     const double c2 = 3.0 / (kA * kA);
     return gamma0 * (1.0 - c1 * height + c2 * height * height);
+}
+
+}  // namespace
+
+double normal_gravity(double sin_lat, double height) {
+    const double s2 = sin_lat * sin_lat;
+    const double gamma0 = kGammaE * (1.0 + kSomigliana * s2) / pmath::sqrt(1.0 - kE2 * s2);
+    return at_height(gamma0, s2, height);
 }
 
 Earth earth_at(double sin_lat, double cos_lat, double height, const Vec3& vel_n) {
@@ -52,8 +61,6 @@ PositionTerms position_terms(double lat, double sin_lat, double cos_lat, double 
     const double rn = kA * inv_sqrt_x;                               // a / sqrt(x)
     const double rm = rn * (1.0 - kE2) * (inv_sqrt_x * inv_sqrt_x);  // a (1 - e^2) / x^(3/2)
     const double gamma0 = kGammaE * (1.0 + kSomigliana * s2) * inv_sqrt_x;
-    const double c1 = 2.0 / kA * (1.0 + kF + kMGrav - 2.0 * kF * s2);
-    const double c2 = 3.0 / (kA * kA);
     const double inv_cos = 1.0 / cos_lat;
     PositionTerms p;
     p.lat = lat;
@@ -65,7 +72,7 @@ PositionTerms position_terms(double lat, double sin_lat, double cos_lat, double 
     p.inv_rn_h_cos = p.inv_rn_h * inv_cos;
     p.sec2_inv_rn_h = p.inv_rn_h_cos * inv_cos;
     p.omega_ie_n = Vec3(0.0, kOmegaIe * cos_lat, kOmegaIe * sin_lat);
-    p.gravity = gamma0 * (1.0 - c1 * height + c2 * height * height);
+    p.gravity = at_height(gamma0, s2, height);
     return p;
 }
 

@@ -564,9 +564,7 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     // length). The reading is taken: the navigation of frame p does not use
     // it, and one tick cannot tell a glitch from a slipped encoder; the
     // indexing machine goes to FAULT (command 0) until pyins_index_reset.
-    if (encoder != encoder_ && mode_ != Mode::kIdle && !resync &&
-        std::fabs(wrap_pi(encoder - encoder_)) >
-            cfg_.index_jump_rad * static_cast<double>(missing + 1u)) {
+    if (mode_ != Mode::kIdle && !resync && encoder_jumped(encoder, missing)) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ENCODER_JUMP);
         count(&counts_.encoder_jumps, 1u);
         if (status == PYINS_OK) {
@@ -589,11 +587,7 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
         }
     }
     // 5. This sample's tick, and the memory for the next one.
-    advance(dtheta_p, dv_p, encoder);
-    last_dtheta_ = dtheta_p;
-    last_dv_ = dv_p;
-    seq_ = sample.seq;
-    seq_valid_ = true;
+    take(sample.seq, dtheta_p, dv_p, encoder);
     if (out != nullptr) {
         output(out);
     }
@@ -604,28 +598,36 @@ size_t Firmware::run_plain(const pyins_sample* samples, size_t n, int64_t tick_e
     if (mode_ != Mode::kNavigate || gap_pending_) {
         return 0u;
     }
-    const bool check_seq = cfg_.seq_mode == PYINS_SEQ_CHECK;
     size_t i = 0u;
     while (i < n && tick_ < tick_end) {
         // step()'s tests on a sample it takes as the next tick, in its order
         const pyins_sample& sample = samples[i];
-        if (!usable(sample) || (check_seq && seq_valid_ && sample.seq - seq_ != 1u)) {
+        if (!usable(sample) || seq_step(sample.seq).kind != SeqKind::kNext) {
             break;
         }
         const double encoder = wrap_two_pi(sample.table_angle_rad);
-        if (encoder != encoder_ && std::fabs(wrap_pi(encoder - encoder_)) > cfg_.index_jump_rad) {
+        if (encoder_jumped(encoder, 0u)) {
             break;
         }
         const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
         const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
-        advance(dtheta_p, dv_p, encoder);
-        last_dtheta_ = dtheta_p;
-        last_dv_ = dv_p;
-        seq_ = sample.seq;
-        seq_valid_ = true;
+        take(sample.seq, dtheta_p, dv_p, encoder);
         i = i + 1u;
     }
     return i;
+}
+
+bool Firmware::encoder_jumped(double encoder, uint32_t missing) const {
+    return encoder != encoder_ &&
+           std::fabs(wrap_pi(encoder - encoder_)) > cfg_.index_jump_rad * static_cast<double>(missing + 1u);
+}
+
+PYINS_HOT_INLINE void Firmware::take(uint32_t seq, const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {
+    advance(dtheta_p, dv_p, encoder);
+    last_dtheta_ = dtheta_p;
+    last_dv_ = dv_p;
+    seq_ = seq;
+    seq_valid_ = true;
 }
 
 void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, double encoder) {

@@ -111,6 +111,12 @@ class Firmware {
     /// Advance one tick with increments taken as good: encoder unwrap, mode
     /// machine, alignment or navigation, indexing; tick + 1.
     void advance(const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
+    /// The encoder moved more than index_jump_rad per tick over missing + 1
+    /// ticks since the last reading.
+    bool encoder_jumped(double encoder, uint32_t missing) const;
+    /// A sample's own tick, and the memory for the next one (the last
+    /// increments and seq): step()'s end, and run_plain()'s loop.
+    void take(uint32_t seq, const Vec3& dtheta_p, const Vec3& dv_p, double encoder);
     /// Bridge `missing` ticks before the sample (dtheta_p, dv_p, encoder):
     /// increments interpolated linearly between the last sample taken and
     /// this one, the encoder along the shortest turn between their readings.

@@ -30,14 +30,14 @@
 // kTermsLatStep (1e-6 rad, 6.4 m) or the height more than kTermsHeightStep
 // (0.01 m) from where they were. A tick carries the latitude-dependent ones
 // (Earth rate, tan L, 1 / cos L) to its own latitude to first order in
-// d = L - L0 (the d^2 terms left out are < 1e-10 of themselves below
-// 80 deg of latitude): kept
-// as they were, the Earth rate of a latitude 6 cm off tilted a static
-// ship's IMU turning on the table by 1e-9 rad in an hour (2.5 mm), where
-// the exact algorithm leaves 1e-6 m. What stays stale is the radii's
-// dependence on latitude and height, 1e-8 of themselves at most (R_M: 3 e^2
-// sin L cos L per radian; 1 mm of position over 100 km). Gravity is kept only while the vertical channel
-// is held (then it reaches nothing but that clamped channel); a free
+// d = L - L0 (the d^2 terms left out are < 1e-10 of themselves below 80 deg
+// of latitude): kept as they were, the Earth rate of a latitude 6 cm off
+// tilted a static ship's IMU turning on the table by 1e-9 rad in an hour
+// (2.5 mm), where the exact algorithm leaves 1e-6 m. What stays stale is
+// the radii's dependence on latitude and height, 1e-8 of themselves at most
+// (R_M: 3 e^2 sin L cos L per radian; 1 mm of position over 100 km).
+// Gravity is kept only while the vertical channel is held (then it reaches
+// nothing but that clamped channel); a free
 // channel's dynamics are gravity's own feedback (-2 g / R per metre,
 // e-folding in ~570 s), so it takes gravity at each tick's latitude and
 // height: 5e-10 m/s^2 of gravity from a latitude 6 cm stale moved it 8 mm

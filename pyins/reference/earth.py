@@ -54,6 +54,12 @@ def normal_gravity(sin_lat, height):
     """
     s2 = sin_lat * sin_lat
     gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
+    return _at_height(gamma0, s2, height)
+
+
+def _at_height(gamma0, s2, height):
+    """gamma0 at height h, s2 = sin^2 L (mirrors at_height in earth.cpp;
+    TR8350.2 eq. 4-3)."""
     c1 = 2.0 / A * (1.0 + F + M_GRAV - 2.0 * F * s2)
     c2 = 3.0 / (A * A)
     return gamma0 * (1.0 - c1 * height + c2 * height * height)
@@ -132,8 +138,6 @@ def position_terms(lat, sin_lat, cos_lat, height):
     rn = A * inv_sqrt_x                                 # a / sqrt(x)
     rm = rn * (1.0 - E2) * (inv_sqrt_x * inv_sqrt_x)    # a (1 - e^2) / x^(3/2)
     gamma0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) * inv_sqrt_x
-    c1 = 2.0 / A * (1.0 + F + M_GRAV - 2.0 * F * s2)
-    c2 = 3.0 / (A * A)
     inv_cos = 1.0 / cos_lat
     inv_rm_h = 1.0 / (rm + height)
     inv_rn_h = 1.0 / (rn + height)
@@ -143,7 +147,7 @@ def position_terms(lat, sin_lat, cos_lat, height):
                          tan_inv_rn_h=tan_lat * inv_rn_h, sec2_inv_rn_h=inv_rn_h_cos * inv_cos,
                          inv_rn_h_cos=inv_rn_h_cos, tan_lat=tan_lat,
                          omega_ie_n=np.array([0.0, OMEGA_IE * cos_lat, OMEGA_IE * sin_lat]),
-                         gravity=gamma0 * (1.0 - c1 * height + c2 * height * height))
+                         gravity=_at_height(gamma0, s2, height))
 
 
 def earth_rate(p, d):

@@ -418,8 +418,7 @@ class Firmware:
         dtheta_p = np.array(dtheta_p, dtype=float)
         dv_p = np.array(dv_p, dtype=float)
         encoder = wrap_two_pi(table_angle_rad)
-        if (encoder != self.encoder and self.mode != abi.PYINS_MODE_IDLE and not resync
-                and abs(wrap_pi(encoder - self.encoder)) > self.cfg["index_jump_rad"] * float(missing + 1)):
+        if self.mode != abi.PYINS_MODE_IDLE and not resync and self.encoder_jumped(encoder, missing):
             self.faults = self.faults | abi.PYINS_FAULT_ENCODER_JUMP
             self.counts["n_encoder_jumps"] = count(self.counts["n_encoder_jumps"])
             if status == abi.PYINS_OK:
@@ -436,12 +435,22 @@ class Firmware:
                 self.bridge(missing, dtheta_p, dv_p, encoder)
                 self.counts["n_seq_bridged"] = count(self.counts["n_seq_bridged"], missing)
         # 5. This sample's tick, and the memory for the next one.
+        self.take(seq, dtheta_p, dv_p, encoder)
+        return status, self.output()
+
+    def encoder_jumped(self, encoder, missing):
+        """More than index_jump_rad per tick over missing + 1 ticks (mirrors
+        Firmware::encoder_jumped)."""
+        return (encoder != self.encoder
+                and abs(wrap_pi(encoder - self.encoder)) > self.cfg["index_jump_rad"] * float(missing + 1))
+
+    def take(self, seq, dtheta_p, dv_p, encoder):
+        """A sample's tick and the memory for the next one (mirrors Firmware::take)."""
         self.advance(dtheta_p, dv_p, encoder)
         self.last_dtheta = dtheta_p.copy()
         self.last_dv = dv_p.copy()
         self.seq = seq
         self.seq_valid = True
-        return status, self.output()
 
     def bridge(self, missing, dtheta_p, dv_p, encoder):
         """Interpolate the missing ticks between the last sample and this one (mirrors bridge)."""
