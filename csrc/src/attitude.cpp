@@ -46,18 +46,6 @@ Quat quat_normalize(const Quat& q) {
     return Quat{q.w * inv, q.x * inv, q.y * inv, q.z * inv};
 }
 
-Quat quat_renormalize(const Quat& q) {
-    const double n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
-    if (!(std::fabs(n2 - 1.0) <= kRenormMax)) {  // also a NaN
-        return quat_normalize(q);
-    }
-    double k = 1.5 - 0.5 * n2;
-    if (q.w < 0.0) {
-        k = -k;
-    }
-    return Quat{q.w * k, q.x * k, q.y * k, q.z * k};
-}
-
 Vec3 quat_rotate(const Quat& q, const Vec3& v) {
     const Vec3 r(q.x, q.y, q.z);
     const Vec3 t = 2.0 * cross(r, v);

@@ -9,6 +9,8 @@
 // Shepperd (1978), J. Guidance 1(3) (quaternion from a rotation matrix).
 #pragma once
 
+#include <cmath>
+
 #include "types.hpp"
 
 namespace pyins::attitude {
@@ -49,9 +51,21 @@ Quat quat_normalize(const Quat& q);
 /// whose norm is 1 - (3/4) e^2 for |q|^2 = 1 + e (below an ulp for
 /// |e| <= kRenormMax); a q further from unit goes to quat_normalize. No
 /// square root or division (the Cortex-M4F's two dearest operations).
-Quat quat_renormalize(const Quat& q);
 /// Largest | |q|^2 - 1 | quat_renormalize corrects by its Newton step.
 inline constexpr double kRenormMax = 1e-8;
+/// (defined here: inlined into every tick's update and record, a call and
+/// a returned Quat cost as much as its 20 flops)
+inline Quat quat_renormalize(const Quat& q) {
+    const double n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    if (!(std::fabs(n2 - 1.0) <= kRenormMax)) {  // also a NaN
+        return quat_normalize(q);
+    }
+    double k = 1.5 - 0.5 * n2;
+    if (q.w < 0.0) {
+        k = -k;
+    }
+    return Quat{q.w * k, q.x * k, q.y * k, q.z * k};
+}
 /// q v q* for a unit quaternion q (= quat_to_mat(q) v), as the sandwich
 /// product written out: t = 2 r x v, v' = v + w t + r x t, r = [x, y, z]
 /// (30 flops against 45 for the matrix and its product).

@@ -106,10 +106,32 @@ int run_every(pyins_core* core, const pyins_sample* samples, size_t n, size_t ou
         // one loop; one tick short of it when its record has no room (a
         // record every tick leaves no run to take: step() at once)
         const uint64_t stop = written == out_capacity ? next - 1u : next;
-        const size_t k = every == 1u ? 0u
-                         : fw->run_plain(samples + i, n - i,
-                                         stop > static_cast<uint64_t>(INT64_MAX) ? INT64_MAX
-                                                                                 : static_cast<int64_t>(stop));
+        size_t k = 0u;
+        if (every == 1u && navs != nullptr) {
+            // a compact record every tick: run_plain writes them as it goes
+            // (as many as there is room for)
+            const uint64_t room = static_cast<uint64_t>(out_capacity - written);
+            const uint64_t headroom = static_cast<uint64_t>(INT64_MAX - fw->tick());
+            k = fw->run_plain(samples + i, n - i,
+                              room >= headroom ? INT64_MAX : fw->tick() + static_cast<int64_t>(room),
+                              navs + written);
+            if (k > 0u) {
+                i = i + k;
+                written = written + k;
+                next = static_cast<uint64_t>(fw->tick()) + 1u;
+                if (n_done != nullptr) {
+                    *n_done = i;
+                }
+                if (n_out != nullptr) {
+                    *n_out = written;
+                }
+                continue;
+            }
+        } else if (every > 1u) {
+            k = fw->run_plain(samples + i, n - i,
+                              stop > static_cast<uint64_t>(INT64_MAX) ? INT64_MAX : static_cast<int64_t>(stop),
+                              nullptr);
+        }
         if (k > 0u) {
             i = i + k;
         } else {
@@ -229,7 +251,7 @@ int pyins_run(pyins_core* core, const pyins_sample* samples, size_t n,
     for (size_t i = 0; i < n;) {
         if (outputs == nullptr) {
             // no records: the plain ticks in one loop (Firmware::run_plain)
-            const size_t k = fw->run_plain(samples + i, n - i, INT64_MAX);
+            const size_t k = fw->run_plain(samples + i, n - i, INT64_MAX, nullptr);
             if (k > 0u) {
                 i = i + k;
                 if (n_done != nullptr) {

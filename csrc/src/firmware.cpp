@@ -594,10 +594,17 @@ int Firmware::step(const pyins_sample& sample, pyins_output* out) {
     return status;
 }
 
-size_t Firmware::run_plain(const pyins_sample* samples, size_t n, int64_t tick_end) {
+size_t Firmware::run_plain(const pyins_sample* samples, size_t n, int64_t tick_end, pyins_nav* navs) {
     if (mode_ != Mode::kNavigate || gap_pending_) {
         return 0u;
     }
+    // one loop each: the test for a record is not in the loop without them
+    return navs == nullptr ? plain_loop<false>(samples, n, tick_end, nullptr)
+                           : plain_loop<true>(samples, n, tick_end, navs);
+}
+
+template <bool kNav>
+size_t Firmware::plain_loop(const pyins_sample* samples, size_t n, int64_t tick_end, pyins_nav* navs) {
     size_t i = 0u;
     while (i < n && tick_ < tick_end) {
         // step()'s tests on a sample it takes as the next tick, in its order
@@ -612,6 +619,9 @@ size_t Firmware::run_plain(const pyins_sample* samples, size_t n, int64_t tick_e
         const Vec3 dtheta_p(sample.dtheta_p_rad[0], sample.dtheta_p_rad[1], sample.dtheta_p_rad[2]);
         const Vec3 dv_p(sample.dv_p_mps[0], sample.dv_p_mps[1], sample.dv_p_mps[2]);
         take(sample.seq, dtheta_p, dv_p, encoder);
+        if (kNav) {
+            fill_nav(&navs[i]);
+        }
         i = i + 1u;
     }
     return i;
@@ -796,7 +806,7 @@ void Firmware::motor_command(pyins_motor_command* cmd) const {
     cmd->index_fault = static_cast<int32_t>(idx_.fault);
 }
 
-void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
+PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
                         double quat_nb[4], uint32_t* state_flags) const {
     const strapdown::NavState& nav = sd_.nav;
     if (has_lever_ != 0 && (mode_ == Mode::kFineAlign || mode_ == Mode::kNavigate)) {
@@ -849,7 +859,9 @@ void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3
     quat_nb[3] = q_nb.z;
 }
 
-void Firmware::nav_record(pyins_nav* nav) const {
+void Firmware::nav_record(pyins_nav* nav) const { fill_nav(nav); }
+
+PYINS_HOT_INLINE void Firmware::fill_nav(pyins_nav* nav) const {
     nav->tick = tick_;
     nav->mode = static_cast<int32_t>(mode_);
     nav->fault_flags = faults_;

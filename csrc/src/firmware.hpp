@@ -73,8 +73,11 @@ class Firmware {
     /// sample, the next seq (or seq not checked), the encoder within its
     /// jump limit: step() on it takes no branch but the tick's. The state
     /// after it is step()'s, bit for bit, without step()'s per-sample
-    /// dispatch; the caller steps the sample that stopped it.
-    size_t run_plain(const pyins_sample* samples, size_t n, int64_t tick_end);
+    /// dispatch; the caller steps the sample that stopped it. With navs
+    /// not null, each sample taken leaves its compact record there
+    /// (navs[0..k), nav_record()'s bits): pyins_run_nav with a record
+    /// every tick in one loop.
+    size_t run_plain(const pyins_sample* samples, size_t n, int64_t tick_end, pyins_nav* navs);
 
     /// How many ticks stepping this sample would add to tick() (0: it would
     /// be rejected or dropped). Changes nothing.
@@ -104,6 +107,11 @@ class Firmware {
     /// (the record's state_flags).
     void solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
                   double quat_nb[4], uint32_t* state_flags) const;
+    /// nav_record()'s body (inlined into run_plain's loop on the host).
+    void fill_nav(pyins_nav* nav) const;
+    /// run_plain's loop, with (kNav) or without a compact record a tick.
+    template <bool kNav>
+    size_t plain_loop(const pyins_sample* samples, size_t n, int64_t tick_end, pyins_nav* navs);
     /// Classify a sample's seq against the last one taken.
     SeqStep seq_step(uint32_t seq) const;
     /// Finite and within the saturation limits.

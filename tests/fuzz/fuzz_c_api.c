@@ -31,7 +31,8 @@
  *    sample (n_done says where); pyins_run_decimated writes the single steps'
  *    records whenever the tick reaches the next multiple of out_every, and
  *    stops with PYINS_E_BUFFER_TOO_SMALL only before a step that would need
- *    one record more than the capacity;
+ *    one record more than the capacity; pyins_run_nav does the same with
+ *    compact records (the single steps' fields of the same names);
  *  - *out of pyins_step equals pyins_get_output afterwards; sticky fault bits
  *    never clear and fault counters never decrease between inits;
  *  - snapshot -> restore -> snapshot reproduces the blob; restoring a
@@ -402,6 +403,7 @@ static unsigned char g_blobs[3][SNAP_MAX] __attribute__((aligned(64)));
 static pyins_sample g_samples[MAX_BATCH];
 static pyins_output g_out_a[MAX_BATCH + 2];
 static pyins_output g_out_b[MAX_BATCH + 2];
+static pyins_nav g_nav_a[MAX_BATCH + 2];
 
 static void require_named(int st, const char *what) {
     if (st != PYINS_OK) {
@@ -492,6 +494,23 @@ static void check_output(const pyins_output *o) {
     }
 }
 
+/* A compact record holds the full record's fields of the same names, bit for bit. */
+static int nav_is_output(const pyins_nav *v, const pyins_output *o) {
+    return v->tick == o->tick && v->mode == o->mode && v->fault_flags == o->fault_flags &&
+           v->state_flags == o->state_flags && v->index_state == o->index_state &&
+           memcmp(&v->lat_rad, &o->lat_rad, 6 * sizeof(double)) == 0 &&
+           memcmp(v->quat_nb, o->quat_nb, 8 * sizeof(double)) == 0 &&
+           memcmp(&v->table_angle_rad, &o->table_angle_rad, sizeof(double)) == 0 &&
+           memcmp(&v->motor_rate_cmd_rad_s, &o->motor_rate_cmd_rad_s, 2 * sizeof(double)) == 0;
+}
+
+/* pyins_run_decimated, or pyins_run_nav (compact records) when compact. */
+static int run_every(fuzz *f, int compact, const pyins_sample *samples, size_t n, size_t every, size_t cap,
+                     size_t *n_done, size_t *n_out) {
+    return compact ? pyins_run_nav((pyins_core *)f->a, samples, n, every, g_nav_a, cap, n_done, n_out)
+                   : pyins_run_decimated((pyins_core *)f->a, samples, n, every, g_out_a, cap, n_done, n_out);
+}
+
 static void get_a(fuzz *f, pyins_output *o) {
     pyins_motor_command cmd;
     REQUIRE_EQ(pyins_get_output((const pyins_core *)f->a, o), PYINS_OK, "get_output on a live instance");
@@ -506,13 +525,7 @@ static void get_a(fuzz *f, pyins_output *o) {
     {
         pyins_nav v;
         REQUIRE_EQ(pyins_get_nav((const pyins_core *)f->a, &v), PYINS_OK, "get_nav");
-        REQUIRE(v.tick == o->tick && v.mode == o->mode && v.fault_flags == o->fault_flags &&
-                    v.state_flags == o->state_flags && v.index_state == o->index_state &&
-                    memcmp(&v.lat_rad, &o->lat_rad, 6 * sizeof(double)) == 0 &&
-                    memcmp(v.quat_nb, o->quat_nb, 8 * sizeof(double)) == 0 &&
-                    memcmp(&v.table_angle_rad, &o->table_angle_rad, sizeof(double)) == 0 &&
-                    memcmp(&v.motor_rate_cmd_rad_s, &o->motor_rate_cmd_rad_s, 2 * sizeof(double)) == 0,
-                "compact record == the record's fields");
+        REQUIRE(nav_is_output(&v, o), "compact record == the record's fields");
     }
 }
 
@@ -769,6 +782,7 @@ static void op_run_decimated(fuzz *f, reader *r) {
     unsigned n = rd_u16(r) % (MAX_BATCH + 1u);
     const unsigned every_b = rd_u8(r);
     const uint8_t capmode = rd_u8(r);
+    const int compact = (capmode & 4u) != 0u;   /* pyins_run_nav */
     size_t every = every_b == 0 ? 0 : (every_b % 64u) + 1u;
     size_t cap, need, n_done = 777, n_out = 777, i, written = 0;
     int st, st_b = PYINS_OK;
@@ -785,22 +799,21 @@ static void op_run_decimated(fuzz *f, reader *r) {
     if (cap > MAX_BATCH + 2u) cap = MAX_BATCH + 2u;
     memcpy(f->pre, f->a, f->size);
     if (every == 0) {
-        st = pyins_run_decimated((pyins_core *)f->a, g_samples, n, 0, g_out_a, cap, &n_done, &n_out);
+        st = run_every(f, compact, g_samples, n, 0, cap, &n_done, &n_out);
         REQUIRE_EQ(st, PYINS_E_BAD_ARG, "out_every 0");
         REQUIRE(n_done == 0 && n_out == 0, "refused run_decimated reports nothing done");
         require_unchanged(f, "out_every 0 changed the state");
         return;
     }
     if (cap < need) {
-        st = pyins_run_decimated((pyins_core *)f->a, g_samples, n, every, g_out_a, cap, &n_done, &n_out);
+        st = run_every(f, compact, g_samples, n, every, cap, &n_done, &n_out);
         REQUIRE_EQ(st, PYINS_E_BUFFER_TOO_SMALL, "decimation buffer too small");
         REQUIRE(n_done == 0 && n_out == 0, "refused run_decimated reports nothing done");
         require_unchanged(f, "refused run_decimated stepped");
         return;
     }
     clone_a_to_b(f);
-    st = pyins_run_decimated((pyins_core *)f->a, n ? g_samples : NULL, n, every, g_out_a, cap, &n_done,
-                             &n_out);
+    st = run_every(f, compact, n ? g_samples : NULL, n, every, cap, &n_done, &n_out);
     require_ok_or_error(st, "run_decimated status");
     {
         uint64_t next = ((uint64_t)f->last.tick / every + 1u) * every;
@@ -830,8 +843,14 @@ static void op_run_decimated(fuzz *f, reader *r) {
     }
     REQUIRE_EQ(n_done, i, "run_decimated n_done");
     REQUIRE_EQ(n_out, written, "run_decimated n_out");
-    require_same((const unsigned char *)g_out_a, (const unsigned char *)g_out_b, written * sizeof g_out_a[0],
-                 __LINE__, "decimated records != single steps");
+    if (compact) {
+        for (i = 0; i < written; ++i) {
+            REQUIRE(nav_is_output(&g_nav_a[i], &g_out_b[i]), "compact records != single steps' fields");
+        }
+    } else {
+        require_same((const unsigned char *)g_out_a, (const unsigned char *)g_out_b, written * sizeof g_out_a[0],
+                     __LINE__, "decimated records != single steps");
+    }
     refresh(f);
 }
 
@@ -1243,6 +1262,16 @@ static void seed_ops(writer *w, int k) {
     wr_u8(w, 9);
     wr_u8(w, 0);
     seed_gen(w, 0, 6, 4, 22u + (uint32_t)k, 0, 0, 1u);   /* seq repeats */
+    wr_u8(w, OP_RUN_DECIMATED);
+    wr_u16(w, 200);
+    wr_u8(w, 64);   /* every 1 */
+    wr_u8(w, 4);    /* compact records (pyins_run_nav) */
+    seed_gen(w, 0, 6, 4, 24u + (uint32_t)k, 0, 0, 4u | (2u << 3));   /* seq gaps of 2 */
+    wr_u8(w, OP_RUN_DECIMATED);
+    wr_u16(w, 150);
+    wr_u8(w, 2);    /* every 3 */
+    wr_u8(w, 5);    /* compact, room to spare */
+    seed_gen(w, 0, 6, 4, 25u + (uint32_t)k, 0, 0, 0);
     wr_u8(w, OP_STEP);
     seed_gen(w, 0, 6, 4, 23u + (uint32_t)k, 0, 0, 4u | (30u << 3));
     wr_u8(w, OP_RESTORE_MUTATED);

@@ -155,12 +155,13 @@ def test_decimated_run_matches_full_run_in_phase():
 
 
 def test_runs_without_records_are_single_steps_bit_for_bit():
-    """Ticks without a record go through Firmware::run_plain (a loop over
-    the plain samples: NAVIGATE, the next seq, the encoder within its jump
-    limit), the others through step(): a stream that mixes both (seq gaps
-    bridged, duplicates, a lost sequence, an encoder jump, a turning table
-    under the two-position scheme, a moving ship) must leave the same
-    instance bytes and the same records as single steps."""
+    """Ticks without a record, and compact records every tick, go through
+    Firmware::run_plain (a loop over the plain samples: NAVIGATE, the next
+    seq, the encoder within its jump limit), the others through step(): a
+    stream that mixes both (seq gaps bridged, duplicates, a lost sequence,
+    an encoder jump, a turning table under the two-position scheme, a
+    moving ship) must leave the same instance bytes and the same records as
+    single steps."""
     rng = np.random.default_rng(11)
     n = 2400
     s = static_samples(n, lat=0.6)
@@ -184,6 +185,17 @@ def test_runs_without_records_are_single_steps_bit_for_bit():
     assert batch.snapshot() == one.snapshot()
     kept = [k for k in range(n) if full["tick"][k] // 7 > (full["tick"][k - 1] // 7 if k else 0)]
     assert dec.tobytes() == full[kept].tobytes()
+    # a compact record every tick: run_plain writes them in its loop, step()
+    # the ones of the samples that stop it (one record per sample that
+    # advanced the tick, a bridged gap's at its sample)
+    compact = native.Firmware(cfg)
+    nav = np.concatenate([compact.run_nav(s[a:b], every=1) for a, b in ((0, 450), (450, 1700), (1700, n))])
+    assert compact.snapshot() == one.snapshot()
+    advanced = [k for k in range(n) if full["tick"][k] > (full["tick"][k - 1] if k else 0)]
+    assert len(advanced) < n and len(nav) == len(advanced)
+    for field in native.NAV_DTYPE.names:
+        assert np.ascontiguousarray(nav[field]).tobytes() == \
+            np.ascontiguousarray(full[advanced][field]).tobytes(), field
 
 
 @pytest.mark.parametrize("lib_path, message", [
