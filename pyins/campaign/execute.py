@@ -186,15 +186,20 @@ def _run_local(tasks, workers, on_done, on_stopped):
         while running:
             done, _ = wait(running, return_when=FIRST_COMPLETED)
             for f in done:
-                t = running.pop(f)
-                exc = f.exception()
-                if isinstance(exc, KeyboardInterrupt):   # the terminal's Ctrl-C reached the worker first
-                    on_stopped(t)
-                    raise KeyboardInterrupt
-                on_done(t, None if exc else f.result(), exc)
-                nxt = next(waiting, None)
-                if nxt is not None:
-                    running[ex.submit(_pool_point, nxt)] = nxt
+                # a Ctrl-C waits until the run is told (a run taken off
+                # `running` and not yet told would be finished on disk and
+                # missing from the counts: the user's Ctrl-C tends to come
+                # just as a run ends)
+                with runs.hold_interrupts(defer=True):
+                    t = running.pop(f)
+                    exc = f.exception()
+                    if isinstance(exc, KeyboardInterrupt):   # the terminal's Ctrl-C reached the worker first
+                        on_stopped(t)
+                        raise KeyboardInterrupt
+                    on_done(t, None if exc else f.result(), exc)
+                    nxt = next(waiting, None)
+                    if nxt is not None:
+                        running[ex.submit(_pool_point, nxt)] = nxt
     except KeyboardInterrupt:
         with runs.hold_interrupts():
             _stop_pool(ex, running, on_done, on_stopped)
@@ -255,17 +260,22 @@ def _run_dask(tasks, scheduler, on_done, on_stopped):
         address = client.scheduler.address
         futs = client.map(_run_point, tasks, pure=False)
         index = {f.key: t for f, t in zip(futs, tasks)}
+        told = set()
         try:
             for f in distributed.as_completed(futs):
-                if f.status == "error":
-                    on_done(index[f.key], None, f.exception())
-                else:
-                    on_done(index[f.key], f.result(), None)
-                f.release()
+                with runs.hold_interrupts(defer=True):   # told whole, as in _run_local
+                    if f.status == "error":
+                        on_done(index[f.key], None, f.exception())
+                    else:
+                        on_done(index[f.key], f.result(), None)
+                    told.add(f.key)
+                    f.release()
         except BaseException:
             client.cancel(futs)
             for f in futs:
-                if not f.done() or f.cancelled():
+                # every run not told, whether it ended or not: on_stopped
+                # counts one that finished on disk as computed
+                if f.key not in told:
                     on_stopped(index[f.key])
             raise
     finally:
