@@ -64,9 +64,20 @@ def test_alignment_cpp_equals_reference(sc):
        n=st.integers(1, 400), arw=st.floats(1e-7, 1e-4), vrw=st.floats(1e-6, 1e-3),
        tilt=st.tuples(st.floats(-1e-2, 1e-2), st.floats(-1e-2, 1e-2)), seed=st.integers(0, 99))
 def test_fine_filter_module_state_and_full_covariance(states, lat, meas_every, n, arw, vrw, tilt, seed):
-    """The fine-alignment module alone (init + n steps): state within 1e-9
-    relative (floor: 1e-9 of its sigma) and every covariance element within
-    1e-9 of sqrt(P_ii P_jj), the scale of that element."""
+    """The fine-alignment module alone (init + n steps): state within tol
+    relative (floor: tol of its sigma) and every covariance element within
+    tol of sqrt(P_ii P_jj), the scale of that element.
+
+    tol = 1e-9 + 20 kappa u: the two engines sum in different orders (BLAS
+    vs Eigen), and the filter amplifies a rounding difference by the
+    condition number kappa of the correlation matrix (u = 2^-53). Well
+    conditioned (kappa < 1e3, most cases) that term is below 2e-11 and the
+    bound is 1e-9. The 8-state filter with precise sensors and a
+    measurement every tick makes the heading and the east gyro bias almost
+    one state (kappa ~4e6); there the heading variance differs by ~3 kappa
+    u, 1.4e-9 of itself at worst (measured over n = 10-400 at latitude 0,
+    where hypothesis found it: arw 1e-7, vrw 1e-6, meas_every 1). A wrong
+    formula moves these elements by their own size, not by 1e-8."""
     from pyins.reference import fine_align
     import hooks
 
@@ -92,5 +103,7 @@ def test_fine_filter_module_state_and_full_covariance(states, lat, meas_every, n
     xc = np.array(list(x))[:states]
     pc = np.array(list(p))[:states * states].reshape(states, states)
     sig = np.sqrt(np.diag(f.p))
-    assert np.all(np.abs(xc - f.x) <= 1e-9 * np.maximum(np.abs(f.x), sig))
-    assert np.all(np.abs(pc - f.p) <= 1e-9 * np.outer(sig, sig))
+    corr_eig = np.linalg.eigvalsh(f.p / np.outer(sig, sig))
+    tol = 1e-9 + 20.0 * (corr_eig[-1] / corr_eig[0]) * np.finfo(float).eps / 2
+    assert np.all(np.abs(xc - f.x) <= tol * np.maximum(np.abs(f.x), sig))
+    assert np.all(np.abs(pc - f.p) <= tol * np.outer(sig, sig))
