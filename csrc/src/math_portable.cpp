@@ -304,31 +304,117 @@ DD atan_kernel(double t, double d) {
     return two_sum(head.hi, tail);
 }
 
+// ---------------------------------------------------------------------------
+// atan2: table-driven reduction (the record's three Euler angles every tick).
+// ---------------------------------------------------------------------------
+
 /// atan2(ay, ax) for finite ay, ax > 0 with 2^-60 <= ay/ax <= 2^60; the angle
 /// is taken from the negative x axis when x_negative (pi - atan(ay/ax)).
+///
+/// The octant's ratio r = n / m in (0, 1] (n, m = the smaller and the larger
+/// of ay, ax) is reduced to the nearest of 65 table points c = i / 64:
+/// atan(r) = atan(c) + atan(t), t = (n - c m) / (m + c n), |t| <= 1/128 + an
+/// ulp, where four terms of the series leave < 2^-56 of t (t^9 / 9). The
+/// numerator is exact to one rounding (m split so that c m_hi is exact; then
+/// Sterbenz), so t's own error is an ulp of t, below a quarter-ulp of the
+/// result for i >= 1, where atan(c) >= 2 |t|. atan(c) is a double-double
+/// (tools/derive_atan_table.py). Two divisions against the four of the
+/// double-double quotient and the fdlibm reduction that asin keeps; measured
+/// within 1 ulp of glibc (tests/c/test_math_portable.cpp).
 double atan2_general(double ay, double ax, bool x_negative) {
-    // Bring ax into [2^-500, 2^500] by an exact power-of-two scaling of both
-    // operands (ay stays normal and finite because the ratio is bounded), so
-    // that Dekker's product below neither overflows nor underflows.
-    if (ax > 0x1p500) {
-        ax *= 0x1p-600;
-        ay *= 0x1p-600;
-    } else if (ax < 0x1p-500) {
-        ax *= 0x1p600;
-        ay *= 0x1p600;
+    static constexpr double kAtanTabHi[65] = {
+        0x0.0p+0, 0x1.fff555bbb729bp-7, 0x1.ffd55bba97625p-6,
+        0x1.7fb818430da2ap-5, 0x1.ff55bb72cfdeap-5, 0x1.3f59f0e7c559dp-4,
+        0x1.7ee182602f10fp-4, 0x1.be39ebe6f07c3p-4, 0x1.fd5ba9aac2f6ep-4,
+        0x1.1e1fafb043727p-3, 0x1.3d6eee8c6626cp-3, 0x1.5c9811e3ec26ap-3,
+        0x1.7b97b4bce5b02p-3, 0x1.9a6a8e96c8626p-3, 0x1.b90d7529260a2p-3,
+        0x1.d77d5df205736p-3, 0x1.f5b75f92c80ddp-3, 0x1.09dc597d86362p-2,
+        0x1.18bf5a30bf178p-2, 0x1.278372057ef46p-2, 0x1.362773707ebccp-2,
+        0x1.44aa436c2af0ap-2, 0x1.530ad9951cd4ap-2, 0x1.614840309cfe2p-2,
+        0x1.6f61941e4def1p-2, 0x1.7d5604b63b3f7p-2, 0x1.8b24d394a1b25p-2,
+        0x1.98cd5454d6b18p-2, 0x1.a64eec3cc23fdp-2, 0x1.b3a911da65c6cp-2,
+        0x1.c0db4c94ec9f0p-2, 0x1.cde53432c1351p-2, 0x1.dac670561bb4fp-2,
+        0x1.e77eb7f175a34p-2, 0x1.f40dd0b541418p-2, 0x1.0039c73c1a40cp-1,
+        0x1.0657e94db30d0p-1, 0x1.0c6145b5b43dap-1, 0x1.1255d9bfbd2a9p-1,
+        0x1.1835a88be7c13p-1, 0x1.1e00babdefeb4p-1, 0x1.23b71e2cc9e6ap-1,
+        0x1.2958e59308e31p-1, 0x1.2ee628406cbcap-1, 0x1.345f01cce37bbp-1,
+        0x1.39c391cd4171ap-1, 0x1.3f13fb89e96f4p-1, 0x1.445065b795b56p-1,
+        0x1.4978fa3269ee1p-1, 0x1.4e8de5bb6ec04p-1, 0x1.538f57b89061fp-1,
+        0x1.587d81f732fbbp-1, 0x1.5d58987169b18p-1, 0x1.6220d115d7b8ep-1,
+        0x1.66d663923e087p-1, 0x1.6b798920b3d99p-1, 0x1.700a7c5784634p-1,
+        0x1.748978fba8e0fp-1, 0x1.78f6bbd5d315ep-1, 0x1.7d528289fa093p-1,
+        0x1.819d0b7158a4dp-1, 0x1.85d69576cc2c5p-1, 0x1.89ff5ff57f1f8p-1,
+        0x1.8e17aa99cc05ep-1, 0x1.921fb54442d18p-1,
+    };
+    static constexpr double kAtanTabLo[65] = {
+        0x0.0p+0, -0x1.220c39d4dff50p-61, -0x1.5ec431444912cp-60,
+        -0x1.86ef8f794f105p-63, -0x1.c934d86d23f1dp-60, 0x1.ac4ce285df847p-58,
+        -0x1.cfb654c0c3d98p-58, 0x1.f7b8f29a05987p-58, -0x1.cd37686760c17p-59,
+        -0x1.b485914dacf8cp-59, 0x1.61a3b0ce9281bp-57, -0x1.054ab2c010f3dp-58,
+        0x1.347b0b4f881cap-58, 0x1.cf601e7b4348ep-59, 0x1.17b10d2e0e5abp-61,
+        0x1.c648d1534597ep-57, 0x1.8ab6e3cf7afbdp-57, 0x1.62e47390cb865p-56,
+        0x1.30ca4748b1bf9p-57, -0x1.077cdd36dfc81p-56, -0x1.963a544b672d8p-57,
+        -0x1.5d5e43c55b3bap-56, -0x1.2566480884082p-57, -0x1.a725715711f00p-56,
+        -0x1.c63aae6f6e918p-56, 0x1.69c885c2b249ap-56, 0x1.b6d0ba3748fa8p-56,
+        0x1.9e6c988fd0a77p-56, -0x1.24dec1b50b7ffp-56, 0x1.ae187b1ca5040p-56,
+        -0x1.cc1ce70934c34p-56, -0x1.a2cfa4418f1adp-56, 0x1.a2b7f222f65e2p-56,
+        0x1.0e53dc1bf3435p-56, -0x1.a3992dc382a23p-57, -0x1.b32c949c9d593p-55,
+        -0x1.d5b495f6349e6p-56, 0x1.974fa13b5404fp-58, -0x1.2bdaee1c0ee35p-58,
+        0x1.c621cec00c301p-55, -0x1.928df287a668fp-58, 0x1.c421c9f38224ep-57,
+        -0x1.09e73b0c6c087p-56, 0x1.c5d5e9ff0cf8dp-55, 0x1.1021137c71102p-55,
+        -0x1.2304331d8bf46p-55, 0x1.ecf8b492644f0p-56, -0x1.f76d0163f79c8p-56,
+        0x1.2419a87f2a458p-56, 0x1.4a33dbeb3796cp-55, -0x1.1bb74abda520cp-55,
+        -0x1.5e5c9d8c5a950p-56, 0x1.0028e4bc5e7cap-57, -0x1.2b785350ee8c1p-57,
+        -0x1.6ea6febe8bbbap-56, -0x1.a80386188c50ep-55, -0x1.8c34d25aadef6p-56,
+        0x1.7b2a6165884a1p-59, 0x1.406a089803740p-55, 0x1.560821e2f3aa9p-55,
+        -0x1.bf76229d3b917p-56, 0x1.6b66e7fc8b8c3p-57, -0x1.55b9a5e177a1bp-55,
+        -0x1.ec182ab042f61p-56, 0x1.1a62633145c07p-55,
+    };
+    // atan(t) = t - q, q = t^3/3 - t^5/5 + t^7/7 (Taylor; |t| <= 2^-7 + ulp)
+    constexpr double kThird = 1.0 / 3.0;
+    constexpr double kFifth = 1.0 / 5.0;
+    constexpr double kSeventh = 1.0 / 7.0;
+    const bool swapped = ay > ax;  // the angle from the y axis: pi/2 -+ atan(ax/ay)
+    double n = swapped ? ax : ay;
+    double m = swapped ? ay : ax;
+    // Bring m into [2^-500, 2^500] by an exact power-of-two scaling of both
+    // (n stays normal, n >= 2^-60 m), so that no product below under- or
+    // overflows.
+    if (m > 0x1p500) {
+        m *= 0x1p-600;
+        n *= 0x1p-600;
+    } else if (m < 0x1p-500) {
+        m *= 0x1p600;
+        n *= 0x1p600;
     }
-    // ay / ax = t + d: ay - t * ax is computed exactly (two_prod, and
-    // ay - p.hi is exact by Sterbenz's lemma); only the division by ax rounds.
-    const double t = ay / ax;
-    const DD p = two_prod(t, ax);
-    const double d = ((ay - p.hi) - p.lo) / ax;
-    const DD a = atan_kernel(t, d);
-    if (!x_negative) {
-        return a.hi + a.lo;
+    const double r = n / m;
+    const int i = static_cast<int>(r * 64.0 + 0.5);  // the nearest table point, 0..64
+    double t = r;
+    if (i > 0) {
+        const double c = static_cast<double>(i) * 0x1p-6;
+        // m = m_hi + m_lo, m_hi with 46 significant bits: c (<= 6 significant
+        // bits, or 1 for i = 64) times m_hi is exact, and so is c m_lo
+        const double m_hi = from_bits(bits_of(m) & ~std::uint64_t{0x7F});
+        const double m_lo = m - m_hi;
+        t = ((n - c * m_hi) - c * m_lo) / (m + c * n);
     }
-    // pi - (a.hi + a.lo), with pi = kPi + kPiLo.
-    const DD s = two_sum(kPi, -a.hi);
-    return s.hi + ((s.lo + kPiLo) - a.lo);
+    const double z = t * t;
+    const double q = t * z * (kThird - z * (kFifth - z * kSeventh));
+    // angle = K + s atan(r): K = 0, s = +1 in the first octant; K = pi/2,
+    // s = -1 (x > 0) or +1 (x < 0) when swapped; K = pi, s = -1 for x < 0.
+    if (!swapped && !x_negative) {
+        const DD head = two_sum(kAtanTabHi[i], t);  // exact
+        return head.hi + (head.lo + (kAtanTabLo[i] - q));
+    }
+    const double k_hi = swapped ? kPio2 : kPi;
+    const double k_lo = swapped ? 0.5 * kPiLo : kPiLo;
+    const double a_lo = kAtanTabLo[i] + (t - q);  // atan(r) - kAtanTabHi[i]
+    if (swapped == x_negative) {  // K + atan(r)
+        const DD head = two_sum(k_hi, kAtanTabHi[i]);  // exact
+        return head.hi + (head.lo + (k_lo + a_lo));
+    }
+    const DD head = two_sum(k_hi, -kAtanTabHi[i]);  // K - atan(r), exact
+    return head.hi + (head.lo + (k_lo - a_lo));
 }
 
 }  // namespace
