@@ -478,13 +478,20 @@ void sincos(double x, double* s, double* c) {
 }
 
 double atan2(double y, double x) {
-    if (is_nan(x) || is_nan(y)) {
-        return kNaN;
-    }
     const bool y_negative = sign_bit(y);
     const bool x_negative = sign_bit(x);  // true for -0: atan2(+-0, -0) = +-pi
     const double ay = magnitude(y);
     const double ax = magnitude(x);
+    // The common case first, in one test: both finite, x non-zero and
+    // 2^-60 <= |y/x| <= 2^60 (so y is non-zero; a NaN fails every
+    // comparison). It is the last branch of the chain below, taken early.
+    if (ax > 0.0 && ax < kInf && ay < kInf && ay * 0x1p60 >= ax && ax * 0x1p60 >= ay) {
+        const double angle = atan2_general(ay, ax, x_negative);
+        return y_negative ? -angle : angle;
+    }
+    if (is_nan(x) || is_nan(y)) {
+        return kNaN;
+    }
 
     // angle = atan2(|y|, x) in [0, pi]; the sign of y is applied at the end.
     double angle;
