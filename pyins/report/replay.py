@@ -23,24 +23,24 @@ import numpy as np
 from pyins import logs
 from pyins.reference import abi
 from pyins.reference.fine_align import EPS, EPS_NU, PHI
-from pyins.report.plotting import pyplot, time_axis
+from pyins.report.plotting import MAX_POINTS, envelope, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
 
 __all__ = ["render", "is_replay"]
 
 _MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
           abi.PYINS_MODE_FINE_ALIGN: "fine alignment", abi.PYINS_MODE_NAVIGATE: "navigation"}
-#: at most this many points per curve: a 72 h log at 1 Hz has 259,200 records
-MAX_POINTS = 4000
-
-
 def is_replay(summary):
     """True for the summary.json of ``pyins replay`` (it names its log)."""
     return "log" in summary and "samples" in summary
 
 
-def _decimate(n):
-    return slice(None, None, max(1, n // MAX_POINTS))
+def _line(ax, t, y, **kw):
+    """One curve drawn through its min/max envelope (`envelope`: at most
+    MAX_POINTS points, every peak kept; a stride would alias a rotation
+    cycle into a slow wave that is not there)."""
+    x, y = envelope(t, y)
+    return ax.plot(x, y, **kw)
 
 
 def _shade_phases(ax, t, mode):
@@ -53,14 +53,12 @@ def _shade_phases(ax, t, mode):
 
 def plot_attitude(rec, hz, path):
     plt = pyplot()
-    k = _decimate(len(rec))
-    t, tl = time_axis(rec["tick"][k] / hz)
+    t, tl = time_axis(rec["tick"] / hz)
     fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-    _shade_phases(ax, t, rec["mode"][k])
-    pitch, roll = np.degrees(rec["euler_b_rad"][k, 0]), np.degrees(rec["euler_b_rad"][k, 1])
-    ax[0].plot(t, pitch, lw=0.8)
-    ax[1].plot(t, roll, lw=0.8)
-    ax[2].plot(t, np.degrees(rec["heading_b_rad"][k]), lw=0.8)
+    _shade_phases(ax, t, rec["mode"])
+    _line(ax[0], t, np.degrees(rec["euler_b_rad"][:, 0]), lw=0.8)
+    _line(ax[1], t, np.degrees(rec["euler_b_rad"][:, 1]), lw=0.8)
+    _line(ax[2], t, np.degrees(rec["heading_b_rad"]), lw=0.8)
     for a, yl in zip(ax, ("pitch [deg]", "roll [deg]", "heading [deg]")):
         a.set_ylabel(yl)
         a.grid(alpha=0.3)
@@ -78,15 +76,16 @@ def plot_alignment(rec, hz, path):
     if not len(fine):
         return False
     plt = pyplot()
-    k = _decimate(len(fine))
-    t, tl = time_axis(fine["tick"][k] / hz)
-    sig = fine["kf_sigma"][k][:, PHI]
+    t, tl = time_axis(fine["tick"] / hz)
+    sig = fine["kf_sigma"][:, PHI]
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    ax[0].semilogy(t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E")
-    ax[0].semilogy(t, sig[:, 1] / ARCSEC_TO_RAD, label="phi_N")
+    _line(ax[0], t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E")
+    _line(ax[0], t, sig[:, 1] / ARCSEC_TO_RAD, label="phi_N")
+    ax[0].set_yscale("log")
     ax[0].set_ylabel("level sigma [arcsec]")
     ax[0].legend(fontsize=8)
-    ax[1].semilogy(t, sig[:, 2] / ARCMIN_TO_RAD, label="phi_U")
+    _line(ax[1], t, sig[:, 2] / ARCMIN_TO_RAD, label="phi_U")
+    ax[1].set_yscale("log")
     ax[1].axhline(10.0, color="k", ls=":", lw=0.8)      # ATT_VALID needs the heading sigma within 10'
     ax[1].set_ylabel("heading sigma [arcmin]")
     ax[1].set_xlabel(tl)
@@ -104,23 +103,22 @@ def plot_errors(err, path):
     """North and east errors against the reference, and the velocity errors
     (a scenario's truth, parked) or the heading error (a truth track)."""
     plt = pyplot()
-    k = _decimate(len(err["time_s"]))
-    t, tl = time_axis(np.asarray(err["time_s"])[k])
+    t, tl = time_axis(np.asarray(err["time_s"]))
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    ax[0].plot(t, np.asarray(err["north_m"])[k], label="north")
-    ax[0].plot(t, np.asarray(err["east_m"])[k], label="east")
+    _line(ax[0], t, np.asarray(err["north_m"]), label="north")
+    _line(ax[0], t, np.asarray(err["east_m"]), label="east")
     ax[0].set_ylabel("position error [m]")
     if "vel_n_mps" in err:
-        vel = np.asarray(err["vel_n_mps"])[k]
-        ax[1].plot(t, vel[:, 1], label="north")
-        ax[1].plot(t, vel[:, 0], label="east")
+        vel = np.asarray(err["vel_n_mps"])
+        _line(ax[1], t, vel[:, 1], label="north")
+        _line(ax[1], t, vel[:, 0], label="east")
         ax[1].set_ylabel("velocity error [m/s]")
     elif "heading_rad" in err:         # a truth track with headings
-        ax[1].plot(t, np.asarray(err["heading_rad"])[k] / ARCMIN_TO_RAD, label="heading")
+        _line(ax[1], t, np.asarray(err["heading_rad"]) / ARCMIN_TO_RAD, label="heading")
         ax[1].set_ylabel("heading error [arcmin]")
     else:                              # a track of positions only
-        ax[1].plot(t, np.hypot(np.asarray(err["north_m"])[k], np.asarray(err["east_m"])[k]),
-                   label="horizontal")
+        _line(ax[1], t, np.hypot(np.asarray(err["north_m"]), np.asarray(err["east_m"])),
+              label="horizontal")
         ax[1].set_ylabel("horizontal error [m]")
     ax[1].set_xlabel(tl)
     for a in ax:
@@ -166,18 +164,29 @@ def _row(name, value):
 _RECORD_BLOCK = 8192
 
 
+def _kept(rows, budget):
+    """The rows of a block that hold each attitude curve's envelope (pitch,
+    roll, heading: `envelope` on each, ``budget`` points a curve) and the
+    rows where the mode changes (the phases' shading)."""
+    i = np.arange(len(rows))
+    curves = (rows["euler_b_rad"][:, 0], rows["euler_b_rad"][:, 1], rows["heading_b_rad"])
+    idx = [envelope(i, c, budget)[0] for c in curves]
+    change = np.flatnonzero(np.diff(rows["mode"]) != 0)
+    idx += [change, change + 1]
+    return rows[np.unique(np.concatenate(idx))]
+
+
 def _records(path):
     """The records the figures draw, read in blocks (`pyins.logs.iter_npz`), so
-    the page of a 72 h replay does not hold its 259,200 records (112 MB): the
-    rows `_decimate` keeps of all of them (plot_attitude's own decimation then
-    keeps them all: the same figure) and every fine-alignment record."""
+    the page of a 72 h replay does not hold its 259,200 records (112 MB):
+    of each block the rows that keep every attitude curve's peaks (its
+    share of MAX_POINTS a curve; plot_attitude's envelope of them is the
+    whole log's), and every fine-alignment record."""
     n = logs.npz_shape(path, "outputs")[0]
-    step = max(1, n // MAX_POINTS)
-    kept, fine, start = [], [], 0
+    kept, fine = [], []
     for rows in logs.iter_npz(path, "outputs", block=_RECORD_BLOCK):
-        kept.append(rows[(-start) % step::step].copy())
+        kept.append(_kept(rows, max(16, MAX_POINTS * len(rows) // max(n, 1))).copy())
         fine.append(rows[rows["mode"] == abi.PYINS_MODE_FINE_ALIGN].copy())
-        start += len(rows)
     if not kept:                        # no record: the empty array as it is
         with np.load(path, allow_pickle=False) as z:
             rec = z["outputs"]

@@ -370,3 +370,55 @@ def test_a_phase_line_says_stopped_when_ctrl_c_ends_it():
         with Phases(buf)("report: figures"):
             raise KeyboardInterrupt
     assert buf.getvalue() == "  report: figures ... stopped\n"
+
+
+def test_a_long_replays_figures_keep_every_peak(tmp_path, drawn):
+    """Before: the replay page thinned its records by a stride (one in 25
+    here), so a one-record excursion drew only if it fell on the stride and
+    a rotation cycle near the stride drew as a slow wave. Now each curve is
+    its min/max envelope, read block by block: every peak is drawn, within
+    MAX_POINTS points a line."""
+    import json
+
+    from pyins import native
+    from pyins.reference import abi
+
+    n = 100_003                                    # 11 blocks of records; a stride would be 25
+    rec = np.zeros(n, dtype=native.OUTPUT_DTYPE)
+    rec["tick"] = np.arange(1, n + 1)
+    rec["mode"] = abi.PYINS_MODE_NAVIGATE
+    rec["mode"][:3000] = abi.PYINS_MODE_COARSE_ALIGN
+    i = np.arange(n)
+    rec["euler_b_rad"][:, 0] = np.radians(2.0) * np.sin(2 * np.pi * i / 25.02)  # aliases at stride 25
+    rec["euler_b_rad"][:, 1] = np.radians(1.0) * np.cos(2 * np.pi * i / 900.0)
+    rec["heading_b_rad"] = np.radians(90.0)
+    spikes = {0: (50_001, np.radians(7.0)), 1: (77_777, np.radians(-6.0))}
+    for axis, (k, v) in spikes.items():
+        rec["euler_b_rad"][k, axis] = v
+    rec["heading_b_rad"][33_333] = np.radians(100.0)
+    out = tmp_path / "replay"
+    out.mkdir()
+    np.savez(out / "navigation.npz", outputs=rec)
+    t = rec["tick"] / 100.0
+    north = np.zeros(n)
+    north[61_111] = 42.0
+    np.savez(out / "errors.npz", time_s=t, north_m=north, east_m=np.zeros(n), vel_n_mps=np.zeros((n, 3)))
+    summary = dict(log="synthetic.imu", samples=n, rate_hz=100, complete=True,
+                   final=dict(mode=3, lat_deg=34.0, lon_deg=108.0, fault_flags=0),
+                   errors=dict(reference="parked", horizontal_max_m=42.0, horizontal_final_m=0.0))
+    (out / "summary.json").write_text(json.dumps(summary))
+    report.render(str(out))
+    att = drawn["attitude.png"]
+    for ax in att + drawn["errors.png"]:
+        for label, x, y in ax["lines"]:
+            assert len(x) <= plotting.MAX_POINTS, (ax["ylabel"], label, len(x))
+    pitch, roll, heading = (ax["lines"][0][2] for ax in att)
+    assert pitch.max() == pytest.approx(7.0) and roll.min() == pytest.approx(-6.0)
+    assert heading.max() == pytest.approx(100.0)
+    # the fast pitch wave keeps its full swing in every stretch of 2,000 records (a stride
+    # of 25 draws it as a wave of ~0.6 of its amplitude there, then of 2 deg, slowly)
+    x = att[0]["lines"][0][1] * 100.0          # the time axis in seconds (1,000 s), as ticks
+    for a in range(3000, n - 2000, 9000):
+        part = pitch[(x >= a) & (x < a + 2000)]
+        assert part.max() > 1.99 and part.min() < -1.99, a
+    assert drawn["errors.png"][0]["lines"][0][2].max() == 42.0
