@@ -46,7 +46,7 @@ def main(argv=None):
                   file=sys.stderr)
             return 2
         cfg, dtheta, dv, table, seq = cases.inputs(name)
-        rec = cases.run(cfg, dtheta, dv, seq)
+        rec = cases.run(cfg, dtheta, dv, seq, turn=name in cases.TURNS)
         digest = hashlib.sha256(rec.tobytes()).hexdigest()
         config = json.dumps({k: _plain(v) for k, v in cfg.items()}, sort_keys=True)
         np.savez_compressed(os.path.join(out_dir, f"{name}.npz"), dtheta=dtheta, dv=dv, seq=seq,

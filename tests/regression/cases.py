@@ -66,7 +66,13 @@ CASES = {
                                           index_steps=[(200, 1, 1.5), (150, 2, -1.0)]),
                      "seed002", False),
     "faults_seq_nan_gap": (_swing, dict(**_SHORT_COARSE, fine_ticks=300, seq_mode=1), "seed000", True),
+    "index_heading_isolation": (_heading_swing, _scheme(7), "seed002", False),
 }
+#: Cases whose stored increments are the ship's (frame b) and which the
+#: harness turns with the table it commands (`_turned`): heading isolation
+#: counter-rotates against the ship's yaw as the firmware measures it, so a
+#: table that did not turn the gyros would feed its own command back.
+TURNS = {"index_heading_isolation"}
 
 
 def inputs(name):
@@ -86,22 +92,45 @@ def inputs(name):
     return cfg, dtheta, dv, table, seq
 
 
-def _closed(cfg, dtheta, dv, seq, dtype, step):
+def _turned(dtheta_b, dv_b, alpha0, alpha1):
+    """The ship's increments of a tick in the frame p of a table that turned
+    from alpha0 to alpha1 during it, to first order: Rz(mid)^T v, plus the
+    turn about z (the plant's omega_ip^p = Rz(alpha)^T omega_ib^b + alpha_dot
+    z). Sine and cosine are the core's portable ones (the test hooks), so
+    the bits are the same on every machine."""
+    lib = native.lib
+    mid = 0.5 * (alpha0 + alpha1)
+    c, s = lib.pyins_t_cos(mid), lib.pyins_t_sin(mid)
+
+    def rot(v):
+        return (c * v[0] + s * v[1], -s * v[0] + c * v[1], v[2])
+    th = rot(dtheta_b)
+    return (th[0], th[1], th[2] + (alpha1 - alpha0)), rot(dv_b)
+
+
+def _closed(cfg, dtheta, dv, seq, dtype, step, turn=False):
     """Every tick's record of ``dtype``, stepping one sample at a time with
     ``step(fw, sample)`` (the record it leaves, a cffi pointer); the encoder
     reads back the last commanded table angle (an ideal table, as in the
-    embedded demo; the increments do not turn with it: the records test
-    bits, not physics)."""
+    embedded demo). The increments turn with it only when ``turn`` (the
+    cases of TURNS: `_turned`); else they are given in p as they are (the
+    records test bits, not physics)."""
     ffi = native.ffi
     fw = native.Firmware(cfg)
     out = np.zeros(len(dtheta), dtype=dtype)
     sample = ffi.new("pyins_sample *")
     enc = float(cfg.get("table_angle_rad", 0.0))
+    alpha = enc                       # the table's unwrapped angle at the tick's start
     two_pi = 2.0 * np.pi
     for k in range(len(dtheta)):
+        th, v = dtheta[k], dv[k]
+        if turn:                      # the table turned to the reading, the short way
+            to = alpha + float(np.remainder(enc - alpha + np.pi, two_pi) - np.pi)
+            th, v = _turned(th, v, alpha, to)
+            alpha = to
         for i in range(3):
-            sample.dtheta_p_rad[i] = dtheta[k, i]
-            sample.dv_p_mps[i] = dv[k, i]
+            sample.dtheta_p_rad[i] = th[i]
+            sample.dv_p_mps[i] = v[i]
         sample.table_angle_rad = enc
         sample.seq = int(seq[k]) & 0xFFFFFFFF
         rec = step(fw, sample)
@@ -110,7 +139,7 @@ def _closed(cfg, dtheta, dv, seq, dtype, step):
     return out
 
 
-def run(cfg, dtheta, dv, seq):
+def run(cfg, dtheta, dv, seq, turn=False):
     """Every tick's output record (OUTPUT_DTYPE, one per sample) through
     pyins_step (_closed). A rejected sample keeps the record the call wrote."""
     rec = native.ffi.new("pyins_output *")
@@ -118,10 +147,10 @@ def run(cfg, dtheta, dv, seq):
     def step(fw, sample):
         native.lib.pyins_step(fw.core, sample, rec)
         return rec[0]
-    return _closed(cfg, dtheta, dv, seq, native.OUTPUT_DTYPE, step)
+    return _closed(cfg, dtheta, dv, seq, native.OUTPUT_DTYPE, step, turn)
 
 
-def run_compact(cfg, dtheta, dv, seq):
+def run_compact(cfg, dtheta, dv, seq, turn=False):
     """As run(), through pyins_run_nav one sample at a time (out_every 1):
     every tick's compact record (NAV_DTYPE). A sample that adds no tick (a
     dropped duplicate) or is rejected writes none: pyins_get_nav then gives
@@ -136,4 +165,4 @@ def run_compact(cfg, dtheta, dv, seq):
         if n_out[0] == 0:
             assert lib.pyins_get_nav(fw.core, nav) == 0
         return nav[0]
-    return _closed(cfg, dtheta, dv, seq, native.NAV_DTYPE, step)
+    return _closed(cfg, dtheta, dv, seq, native.NAV_DTYPE, step, turn)
