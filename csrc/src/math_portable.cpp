@@ -312,15 +312,18 @@ DD atan_kernel(double t, double d) {
 /// is taken from the negative x axis when x_negative (pi - atan(ay/ax)).
 ///
 /// The octant's ratio r = n / m in (0, 1] (n, m = the smaller and the larger
-/// of ay, ax) is reduced to the nearest of 65 table points c = i / 64:
-/// atan(r) = atan(c) + atan(t), t = (n - c m) / (m + c n), |t| <= 1/128 + an
-/// ulp, where four terms of the series leave < 2^-56 of t (t^9 / 9). The
-/// numerator is exact to one rounding (m split so that c m_hi is exact; then
-/// Sterbenz), so t's own error is an ulp of t, below a quarter-ulp of the
-/// result for i >= 1, where atan(c) >= 2 |t|. atan(c) is a double-double
-/// (tools/derive_atan_table.py). Two divisions against the four of the
-/// double-double quotient and the fdlibm reduction that asin keeps; measured
-/// within 1 ulp of glibc (tests/c/test_math_portable.cpp).
+/// of ay, ax) is reduced to the nearest of 65 table points c = i / 64 when
+/// r >= 1/64: atan(r) = atan(c) + atan(t), t = (n - c m) / (m + c n),
+/// 0 <= t < 1/128 for i = 1 and |t| <= 1/128 + an ulp above. The numerator
+/// is exact to one rounding (m split so that c m_hi is exact; then
+/// Sterbenz), so t is within ~1.5 ulp of itself, which is at most a third of
+/// the result: a few tenths of its ulp. Below 1/64 (c = 0) t is the quotient
+/// itself, whose rounding would be half the result's error: its remainder d
+/// is carried (Dekker's product) and the result rounded once. The series to
+/// t^9 leaves < 2^-63 of t (t^11 / 11 at t = 2^-6). atan(c) is a
+/// double-double (tools/derive_atan_table.py). Two divisions against the
+/// four of the double-double quotient and the fdlibm reduction that asin
+/// keeps; measured within 1 ulp of glibc (tests/c/test_math_portable.cpp).
 double atan2_general(double ay, double ax, bool x_negative) {
     static constexpr double kAtanTabHi[65] = {
         0x0.0p+0, 0x1.fff555bbb729bp-7, 0x1.ffd55bba97625p-6,
@@ -370,10 +373,11 @@ double atan2_general(double ay, double ax, bool x_negative) {
         -0x1.bf76229d3b917p-56, 0x1.6b66e7fc8b8c3p-57, -0x1.55b9a5e177a1bp-55,
         -0x1.ec182ab042f61p-56, 0x1.1a62633145c07p-55,
     };
-    // atan(t) = t - q, q = t^3/3 - t^5/5 + t^7/7 (Taylor; |t| <= 2^-7 + ulp)
+    // atan(t) = t - q, q = t^3/3 - t^5/5 + t^7/7 - t^9/9 (Taylor; |t| < 2^-6)
     constexpr double kThird = 1.0 / 3.0;
     constexpr double kFifth = 1.0 / 5.0;
     constexpr double kSeventh = 1.0 / 7.0;
+    constexpr double kNinth = 1.0 / 9.0;
     const bool swapped = ay > ax;  // the angle from the y axis: pi/2 -+ atan(ax/ay)
     double n = swapped ? ax : ay;
     double m = swapped ? ay : ax;
@@ -388,8 +392,10 @@ double atan2_general(double ay, double ax, bool x_negative) {
         n *= 0x1p600;
     }
     const double r = n / m;
-    const int i = static_cast<int>(r * 64.0 + 0.5);  // the nearest table point, 0..64
+    // the nearest table point, 1..64, for r >= 1/64; 0 below
+    const int i = r < 0x1p-6 ? 0 : static_cast<int>(r * 64.0 + 0.5);
     double t = r;
+    double d = 0.0;  // t + d = n / m when i == 0
     if (i > 0) {
         const double c = static_cast<double>(i) * 0x1p-6;
         // m = m_hi + m_lo, m_hi with 46 significant bits: c (<= 6 significant
@@ -397,18 +403,23 @@ double atan2_general(double ay, double ax, bool x_negative) {
         const double m_hi = from_bits(bits_of(m) & ~std::uint64_t{0x7F});
         const double m_lo = m - m_hi;
         t = ((n - c * m_hi) - c * m_lo) / (m + c * n);
+    } else {
+        // n - r m exactly (two_prod; n - p.hi is exact by Sterbenz)
+        const DD p = two_prod(r, m);
+        d = ((n - p.hi) - p.lo) / m;
     }
     const double z = t * t;
-    const double q = t * z * (kThird - z * (kFifth - z * kSeventh));
+    const double q = t * z * (kThird - z * (kFifth - z * (kSeventh - z * kNinth)));
     // angle = K + s atan(r): K = 0, s = +1 in the first octant; K = pi/2,
     // s = -1 (x > 0) or +1 (x < 0) when swapped; K = pi, s = -1 for x < 0.
+    // (d: atan(t + d) = atan(t) + d to far below an ulp, d being ~ulp(t))
     if (!swapped && !x_negative) {
         const DD head = two_sum(kAtanTabHi[i], t);  // exact
-        return head.hi + (head.lo + (kAtanTabLo[i] - q));
+        return head.hi + (head.lo + ((kAtanTabLo[i] + d) - q));
     }
     const double k_hi = swapped ? kPio2 : kPi;
     const double k_lo = swapped ? 0.5 * kPiLo : kPiLo;
-    const double a_lo = kAtanTabLo[i] + (t - q);  // atan(r) - kAtanTabHi[i]
+    const double a_lo = kAtanTabLo[i] + ((t + d) - q);  // atan(r) - kAtanTabHi[i]
     if (swapped == x_negative) {  // K + atan(r)
         const DD head = two_sum(k_hi, kAtanTabHi[i]);  // exact
         return head.hi + (head.lo + (k_lo + a_lo));

@@ -446,7 +446,8 @@ void test_atan2() {
         check_atan2_pairs("|y/x| in 1e1..1e20", ys, xs, odd);
     }
     {
-        // Around the breakpoints 7/16, 11/16, 19/16, 39/16 and the 2^+-60 cuts.
+        // Around 7/16, 11/16, 19/16, 39/16 (asin's and the former atan2's
+        // breakpoints) and the 2^+-60 cuts.
         std::vector<double> ys;
         std::vector<double> xs;
         const double cuts[] = {0.4375, 0.6875, 1.1875, 2.4375, 0x1p60, 0x1p-60};
@@ -457,6 +458,40 @@ void test_atan2() {
             ys.push_back(rng.random_sign(std::fabs(x) * c * (1.0 + rng.uniform(-1e-9, 1e-9))));
         }
         check_atan2_pairs("ratio near breakpoints and 2^+-60", ys, xs, odd);
+    }
+    {
+        // Around the table's midpoints (i + 1/2) / 64, where the reduction
+        // changes its point c = i / 64 (|t| reaches 1/128), on both sides of
+        // the octant (ratio and its inverse), a few ulps and 1e-9 off; and
+        // |x| at the 2^+-500 rescaling cuts.
+        std::vector<double> ys;
+        std::vector<double> xs;
+        for (int i = 0; i < kPoints; ++i) {
+            const double mid = (static_cast<double>(rng.next() % 64u) + 0.5) / 64.0;
+            const double off = i % 2 == 0 ? rng.uniform(-8e-16, 8e-16) : rng.uniform(-1e-9, 1e-9);
+            const double ratio = mid * (1.0 + off);
+            const double x = i % 8 == 0 ? rng.random_sign(rng.uniform(0.5, 2.0) * (i % 16 == 0 ? 0x1p500 : 0x1p-500))
+                                        : signed_mag(-3.0, 3.0);
+            xs.push_back(x);
+            ys.push_back(rng.random_sign(std::fabs(x) * (i % 4 < 2 ? ratio : 1.0 / ratio)));
+        }
+        check_atan2_pairs("ratio near the table midpoints, |x| near 2^+-500", ys, xs, odd);
+    }
+    {
+        // Small ratios, where the quotient is the result (its remainder is
+        // carried): near 2^-k, k = 6..30 (a result's binade below its
+        // quotient's), and at the 1/64 switch to the table; both octants.
+        std::vector<double> ys;
+        std::vector<double> xs;
+        for (int i = 0; i < kPoints; ++i) {
+            const double ratio = i % 3 == 0 ? 0x1p-6 * (1.0 + rng.uniform(-1e-12, 1e-12))
+                                            : std::ldexp(1.0 + rng.uniform(-1e-13, 1e-13),
+                                                         -6 - static_cast<int>(rng.next() % 25u));
+            const double x = signed_mag(-3.0, 3.0);
+            xs.push_back(x);
+            ys.push_back(rng.random_sign(std::fabs(x) * (i % 2 == 0 ? ratio : 1.0 / ratio)));
+        }
+        check_atan2_pairs("ratio near 2^-k and the 1/64 switch", ys, xs, odd);
     }
     {
         // Whole exponent range, including subnormals and near overflow.
