@@ -103,8 +103,9 @@ int run_every(pyins_core* core, const pyins_sample* samples, size_t n, size_t ou
     uint64_t next = (static_cast<uint64_t>(fw->tick()) / every + 1u) * every;
     for (size_t i = 0; i < n;) {
         // the plain ticks before the next record (Firmware::run_plain), in
-        // one loop; one tick short of it when its record has no room (a
-        // record every tick leaves no run to take: step() at once)
+        // one loop; one tick short of it when its record has no room. A
+        // full record every tick leaves no run to take (step() at once); a
+        // compact one every tick is written in run_plain's loop.
         const uint64_t stop = written == out_capacity ? next - 1u : next;
         size_t k = 0u;
         if (every == 1u && navs != nullptr) {

@@ -806,8 +806,8 @@ void Firmware::motor_command(pyins_motor_command* cmd) const {
     cmd->index_fault = static_cast<int32_t>(idx_.fault);
 }
 
-PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3], double quat_np[4],
-                        double quat_nb[4], uint32_t* state_flags) const {
+PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* height, double vel_n[3],
+                                         double quat_np[4], double quat_nb[4], uint32_t* state_flags) const {
     const strapdown::NavState& nav = sd_.nav;
     if (has_lever_ != 0 && (mode_ == Mode::kFineAlign || mode_ == Mode::kNavigate)) {
         // The state is the accelerometers'; the record the reference point's.
