@@ -78,3 +78,36 @@ def test_every_mode_and_scheme_is_covered():
     # heading isolation (7) with the increments turned by the commanded table (cases.TURNS)
     assert schemes == {0, 1, 2, 3, 4, 5, 6, 7}
     assert {0, 1, 2} <= methods and states == {5, 8, 12}
+
+
+@pytest.mark.parametrize("name", sorted(set(cases.CASES) - cases.TURNS))
+def test_compact_records_of_one_batch_are_the_single_steps(name):
+    """pyins_run_nav with a record every tick over a whole case in one call
+    (Firmware::run_plain's loop writes the records of the plain samples,
+    step() takes the others: alignment, seq gaps, the rejected sample) gives
+    the records of one sample at a time, bit for bit: one record per sample
+    that advanced the tick. The encoder reads what the single steps' harness
+    fed back (the last commanded angle), so the inputs are the same."""
+    d = np.load(os.path.join(DATA, f"{name}.npz"))
+    cfg = json.loads(str(d["config"]))
+    one = cases.run_compact(cfg, d["dtheta"], d["dv"], d["seq"])
+    n = len(one)
+    enc = np.empty(n)
+    enc[0] = float(cfg.get("table_angle_rad", 0.0))
+    enc[1:] = np.mod(one["table_angle_cmd_rad"][:-1], 2.0 * np.pi)
+    s = native.make_samples(d["dtheta"], d["dv"], enc, np.asarray(d["seq"]) & 0xFFFFFFFF)
+    fw = native.Firmware(cfg)
+    parts, start = [], 0
+    while start < n:
+        try:
+            parts.append(fw.run_nav(s[start:], every=1))
+            break
+        except native.SampleError as e:     # faults_seq_nan_gap's NaN: rejected, the run goes on after it
+            parts.append(e.outputs)
+            start += e.index + 1
+    batch = np.concatenate(parts)
+    advanced = [k for k in range(n) if one["tick"][k] > (one["tick"][k - 1] if k else 0)]
+    assert len(batch) == len(advanced) > 2000
+    if batch.tobytes() != one[advanced].tobytes():
+        k = next(i for i in range(len(batch)) if batch[i].tobytes() != one[advanced][i].tobytes())
+        pytest.fail(f"{name}: record {k} (tick {one[advanced][k]['tick']}) differs from the single steps'")
