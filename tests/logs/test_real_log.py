@@ -247,3 +247,23 @@ def test_a_200_hz_split_of_the_real_log_aligns_as_the_100_hz_log(real, coarse_ru
     assert summary["aligned"]["time_s"] == want["time_s"]
     for k in ("pitch_deg", "roll_deg", "heading_deg"):
         assert abs(summary["aligned"][k] - want[k]) * 3600 < 1.0, k
+
+
+def test_compact_records_every_tick_of_the_real_log_are_the_full_records_fields(real):
+    """The recorded log in one pyins_run_nav call with a record every tick
+    (120 s of coarse alignment through step(), then 180 s of navigation
+    whose records run_plain's loop writes): every record is the full
+    record's fields of the same names, bit for bit, and the navigation
+    comes out aligned and without a fault."""
+    from pyins import native
+    cfg = dict(lat_rad=LAT * DEG_TO_RAD, lon_rad=LON * DEG_TO_RAD, height_m=HEIGHT,
+               coarse_ticks=int(COARSE_S * 100), fine_ticks=0)
+    s = native.make_samples(real.dtheta_p, real.dv_p)
+    full = native.Firmware(cfg).run(s)
+    compact = native.Firmware(cfg).run_nav(s, every=1)
+    assert len(compact) == len(full) == len(s)
+    for field in native.NAV_DTYPE.names:
+        assert np.ascontiguousarray(compact[field]).tobytes() == np.ascontiguousarray(full[field]).tobytes(), field
+    # the alignment's last sample ends it: its record is the first in NAVIGATE
+    nav = compact["mode"] == 3
+    assert np.count_nonzero(nav) == len(s) - int(COARSE_S * 100) + 1 and compact["fault_flags"][-1] == 0
