@@ -13,7 +13,7 @@ import numpy as np
 
 from pyins.units import UNITS
 
-__all__ = ["pyplot", "margins", "time_axis", "envelope", "cycle_window", "MAX_POINTS"]
+__all__ = ["pyplot", "margins", "time_axis", "envelope", "line", "cycle_window", "MAX_POINTS"]
 
 #: at most this many points per plotted line: a 72 h run at 1 Hz has 259,200
 #: records, and a figure is 800-1100 px wide
@@ -77,6 +77,13 @@ def envelope(x, y, max_points=MAX_POINTS):
                                       if not np.isnan(tail).all() else [0]))
     idx = np.unique(np.concatenate(parts).astype(np.int64))
     return x[idx], y[idx]
+
+
+def line(ax, t, y, *args, log=False, **kw):
+    """One curve drawn through its min/max envelope (`envelope`), on a
+    logarithmic y axis when ``log``; ``args``, ``kw`` as for ax.plot."""
+    x, y = envelope(t, y)
+    return (ax.semilogy if log else ax.plot)(x, y, *args, **kw)
 
 
 def cycle_window(index_step, index_state, cycles=3, min_cycles=8):

@@ -23,7 +23,7 @@ import numpy as np
 from pyins import logs
 from pyins.reference import abi
 from pyins.reference.fine_align import EPS, EPS_NU, PHI
-from pyins.report.plotting import MAX_POINTS, envelope, pyplot, time_axis
+from pyins.report.plotting import MAX_POINTS, envelope, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
 
 __all__ = ["render", "is_replay"]
@@ -33,14 +33,6 @@ _MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alig
 def is_replay(summary):
     """True for the summary.json of ``pyins replay`` (it names its log)."""
     return "log" in summary and "samples" in summary
-
-
-def _line(ax, t, y, **kw):
-    """One curve drawn through its min/max envelope (`envelope`: at most
-    MAX_POINTS points, every peak kept; a stride would alias a rotation
-    cycle into a slow wave that is not there)."""
-    x, y = envelope(t, y)
-    return ax.plot(x, y, **kw)
 
 
 def _shade_phases(ax, t, mode):
@@ -56,9 +48,9 @@ def plot_attitude(rec, hz, path):
     t, tl = time_axis(rec["tick"] / hz)
     fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     _shade_phases(ax, t, rec["mode"])
-    _line(ax[0], t, np.degrees(rec["euler_b_rad"][:, 0]), lw=0.8)
-    _line(ax[1], t, np.degrees(rec["euler_b_rad"][:, 1]), lw=0.8)
-    _line(ax[2], t, np.degrees(rec["heading_b_rad"]), lw=0.8)
+    line(ax[0], t, np.degrees(rec["euler_b_rad"][:, 0]), lw=0.8)
+    line(ax[1], t, np.degrees(rec["euler_b_rad"][:, 1]), lw=0.8)
+    line(ax[2], t, np.degrees(rec["heading_b_rad"]), lw=0.8)
     for a, yl in zip(ax, ("pitch [deg]", "roll [deg]", "heading [deg]")):
         a.set_ylabel(yl)
         a.grid(alpha=0.3)
@@ -79,13 +71,11 @@ def plot_alignment(rec, hz, path):
     t, tl = time_axis(fine["tick"] / hz)
     sig = fine["kf_sigma"][:, PHI]
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    _line(ax[0], t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E")
-    _line(ax[0], t, sig[:, 1] / ARCSEC_TO_RAD, label="phi_N")
-    ax[0].set_yscale("log")
+    line(ax[0], t, sig[:, 0] / ARCSEC_TO_RAD, label="phi_E", log=True)
+    line(ax[0], t, sig[:, 1] / ARCSEC_TO_RAD, label="phi_N", log=True)
     ax[0].set_ylabel("level sigma [arcsec]")
     ax[0].legend(fontsize=8)
-    _line(ax[1], t, sig[:, 2] / ARCMIN_TO_RAD, label="phi_U")
-    ax[1].set_yscale("log")
+    line(ax[1], t, sig[:, 2] / ARCMIN_TO_RAD, label="phi_U", log=True)
     ax[1].axhline(10.0, color="k", ls=":", lw=0.8)      # ATT_VALID needs the heading sigma within 10'
     ax[1].set_ylabel("heading sigma [arcmin]")
     ax[1].set_xlabel(tl)
@@ -105,19 +95,19 @@ def plot_errors(err, path):
     plt = pyplot()
     t, tl = time_axis(np.asarray(err["time_s"]))
     fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    _line(ax[0], t, np.asarray(err["north_m"]), label="north")
-    _line(ax[0], t, np.asarray(err["east_m"]), label="east")
+    line(ax[0], t, np.asarray(err["north_m"]), label="north")
+    line(ax[0], t, np.asarray(err["east_m"]), label="east")
     ax[0].set_ylabel("position error [m]")
     if "vel_n_mps" in err:
         vel = np.asarray(err["vel_n_mps"])
-        _line(ax[1], t, vel[:, 1], label="north")
-        _line(ax[1], t, vel[:, 0], label="east")
+        line(ax[1], t, vel[:, 1], label="north")
+        line(ax[1], t, vel[:, 0], label="east")
         ax[1].set_ylabel("velocity error [m/s]")
     elif "heading_rad" in err:         # a truth track with headings
-        _line(ax[1], t, np.asarray(err["heading_rad"]) / ARCMIN_TO_RAD, label="heading")
+        line(ax[1], t, np.asarray(err["heading_rad"]) / ARCMIN_TO_RAD, label="heading")
         ax[1].set_ylabel("heading error [arcmin]")
     else:                              # a track of positions only
-        _line(ax[1], t, np.hypot(np.asarray(err["north_m"]), np.asarray(err["east_m"])),
+        line(ax[1], t, np.hypot(np.asarray(err["north_m"]), np.asarray(err["east_m"])),
               label="horizontal")
         ax[1].set_ylabel("horizontal error [m]")
     ax[1].set_xlabel(tl)

@@ -39,7 +39,7 @@ from pyins import metrics, records, runs
 from pyins.metrics import FIGURE_METRICS, display
 from pyins.progress import phase
 from pyins.reference import abi, earth
-from pyins.report.plotting import cycle_window, envelope, pyplot, time_axis
+from pyins.report.plotting import cycle_window, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
 
 __all__ = ["render", "load", "plot_errors", "plot_alignment", "plot_table", "plot_comparison",
@@ -129,12 +129,6 @@ def _angle_unit(values_rad):
     return ("arcmin", ARCMIN_TO_RAD) if big > ARCMIN_TO_RAD else ("arcsec", ARCSEC_TO_RAD)
 
 
-def _line(ax, t, y, *args, log=False, **kw):
-    """One curve, as its min/max envelope (`pyins.report.plotting.envelope`)."""
-    x, y = envelope(t, y)
-    return (ax.semilogy if log else ax.plot)(x, y, *args, **kw)
-
-
 def _clock(series):
     """(seconds per unit, axis label) of one time axis for every variant of a
     figure: the unit `time_axis` picks for the longest of them (a stopped
@@ -182,14 +176,14 @@ def plot_errors(summary, series, path):
         kw = dict(label=label, lw=0.9, color=colour[label])
         if nav:
             dlat, dlon = ll[label]
-            _line(ax[0, 0], t, s["horizontal_m"] / pos_scale, **kw)
-            _line(ax[0, 1], t, np.hypot(s["vel_err_n_mps"][:, 0], s["vel_err_n_mps"][:, 1]), **kw)
-            _line(ax[1, 0], t, s["north_m"] / pos_scale, **kw)
-            _line(ax[1, 1], t, s["east_m"] / pos_scale, **kw)
-            _line(ax[2, 0], t, dlat / ang_scale, **kw)
-            _line(ax[2, 1], t, dlon / ang_scale, **kw)
-        _line(ax[-1, 0], t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, **kw)
-        _line(ax[-1, 1], t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, **kw)
+            line(ax[0, 0], t, s["horizontal_m"] / pos_scale, **kw)
+            line(ax[0, 1], t, np.hypot(s["vel_err_n_mps"][:, 0], s["vel_err_n_mps"][:, 1]), **kw)
+            line(ax[1, 0], t, s["north_m"] / pos_scale, **kw)
+            line(ax[1, 1], t, s["east_m"] / pos_scale, **kw)
+            line(ax[2, 0], t, dlat / ang_scale, **kw)
+            line(ax[2, 1], t, dlon / ang_scale, **kw)
+        line(ax[-1, 0], t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, **kw)
+        line(ax[-1, 1], t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, **kw)
     for a in ax[-1]:
         a.set_xlabel(tl)
     names = ([f"horizontal position error [{pos_unit}]", "horizontal velocity error [m/s]",
@@ -222,11 +216,11 @@ def plot_alignment(summary, series, path):
         t = s["time_s"] / ts
         for i in range(3):
             # |error| on a log axis: the first seconds are degrees, the end arc-seconds
-            _line(ax[i], t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9, log=True,
+            line(ax[i], t, np.abs(s["att_err_n_rad"][:, i]) / scale[i], label=label, lw=0.9, log=True,
                   color=colour[label])
             sig = s["outputs"]["kf_sigma"][:, i]
             if np.any(sig > 0):
-                _line(ax[i], t, 3 * sig / scale[i], "k:", lw=0.8, log=True)
+                line(ax[i], t, 3 * sig / scale[i], "k:", lw=0.8, log=True)
     ax[2].set_xlabel(tl)
     for a, n in zip(ax, names):
         a.set_ylabel(f"|{n.split(' ')[0]}| {n.split(' ')[1]}")
@@ -281,10 +275,10 @@ def plot_table(summary, series, path):
         if label in sums:
             curves += [(2, o["index_a_c"], "-", f"{label}: A_c"), (2, o["index_a_s"], "--", f"{label}: A_s")]
         for row, y, style, name in curves:
-            _line(main[row], t, y, style, label=name, lw=0.7, color=colour[label])
+            line(main[row], t, y, style, label=name, lw=0.7, color=colour[label])
             if zoom:
                 k = (s["time_s"] >= zoom[0]) & (s["time_s"] <= zoom[1])
-                _line(side[row], s["time_s"][k] / zs, y[k], style, color=colour[label], lw=0.9)
+                line(side[row], s["time_s"][k] / zs, y[k], style, color=colour[label], lw=0.9)
     names = ["table angle (encoder) [deg]", "IMU yaw psi_p [deg]", "A_c, A_s [samples]"]
     for a, yl in zip(main, names):
         a.set_ylabel(yl, fontsize=9)
