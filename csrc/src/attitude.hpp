@@ -46,15 +46,15 @@ Quat quat_mul_z(const Quat& p, double c, double s);
 Quat quat_conj(const Quat& q);
 /// Unit quaternion with non-negative scalar part.
 Quat quat_normalize(const Quat& q);
+/// Largest | |q|^2 - 1 | quat_renormalize corrects by its Newton step.
+inline constexpr double kRenormMax = 1e-8;
 /// quat_normalize for a q that is unit to rounding (a product of unit
 /// quaternions): q (3 - |q|^2) / 2, one Newton step of 1 / sqrt from 1,
 /// whose norm is 1 - (3/4) e^2 for |q|^2 = 1 + e (below an ulp for
 /// |e| <= kRenormMax); a q further from unit goes to quat_normalize. No
 /// square root or division (the Cortex-M4F's two dearest operations).
-/// Largest | |q|^2 - 1 | quat_renormalize corrects by its Newton step.
-inline constexpr double kRenormMax = 1e-8;
-/// (defined here: inlined into every tick's update and record, a call and
-/// a returned Quat cost as much as its 20 flops)
+/// Defined here: it is inlined into every tick's update and record, where
+/// a call and a returned Quat would cost as much as its 20 flops.
 inline Quat quat_renormalize(const Quat& q) {
     const double n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
     if (!(std::fabs(n2 - 1.0) <= kRenormMax)) {  // also a NaN
