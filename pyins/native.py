@@ -9,6 +9,13 @@ not later with corrupted memory.
 
 ``PYINS_CORE_LIB=/path/to/libpyins_core.so`` loads another build (its
 headers are taken from beside it, else from the source tree).
+
+The ABI's data contract (the record dtypes, CONFIG_FIELDS, the errors,
+make_samples, the status texts) lives in `pyins.contract`, which needs no
+library; it is re-exported here under the same names (the same objects).
+This module adds what needs the library: the dlopen and its checks,
+``make_config`` (the C defaults, ``pyins_config_default``), `Firmware`,
+`Plant` and the library's own ``status_str``.
 """
 import importlib.resources
 import os
@@ -17,6 +24,7 @@ from pathlib import Path
 import cffi
 import numpy as np
 
+from . import contract
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
@@ -33,21 +41,19 @@ def _package_file(name):
 
 
 def _locate():
-    """Paths (library, {header name: header text})."""
+    """Paths (library, {header name: header text}); the headers as
+    `pyins.contract.find_header` finds them (beside an overriding library,
+    else inside the package, then the source tree)."""
     override = os.environ.get("PYINS_CORE_LIB")
     lib_path = Path(override) if override else _package_file(_LIB_NAME)
     if not lib_path.is_file():
         where = f"PYINS_CORE_LIB={override}" if override else "inside the installed pyins package"
         raise ImportError(f"pyins: the firmware core library {_LIB_NAME} was not found {where}; {_REBUILD}.")
     texts = {}
-    source = Path(__file__).resolve().parent.parent / "csrc"
     for name in _HEADERS:
-        candidates = [Path(str(lib_path)).parent / name] if override else [_package_file(name)]
-        candidates.append(source / ("plant" if name == "pyins_plant.h" else "include") / name)
-        for c in candidates:
-            if c.is_file():
-                texts[name] = c.read_text()
-                break
+        found = contract.find_header(name, Path(str(lib_path)).parent if override else None)
+        if found is not None:
+            texts[name] = found[1]
     if "pyins_core.h" not in texts:
         raise ImportError(f"pyins: pyins_core.h was not found next to {lib_path}; {_REBUILD}.")
     return lib_path, texts
@@ -74,10 +80,16 @@ def _load():
                           f"pyins expects {EXPECTED_ABI[0]}.{EXPECTED_ABI[1]}; {_REBUILD}.")
     for struct, fn in (("pyins_config", lib.pyins_sizeof_config),
                        ("pyins_sample", lib.pyins_sizeof_sample),
-                       ("pyins_output", lib.pyins_sizeof_output)):
+                       ("pyins_output", lib.pyins_sizeof_output),
+                       ("pyins_nav", lib.pyins_sizeof_nav)):
         if ffi.sizeof(struct) != fn():
             raise ImportError(f"pyins: struct {struct} is {fn()} bytes in {lib_path} but "
                               f"{ffi.sizeof(struct)} bytes in its header; {_REBUILD}.")
+    for struct, dtype in (("pyins_sample", contract.SAMPLE_DTYPE), ("pyins_output", contract.OUTPUT_DTYPE),
+                          ("pyins_nav", contract.NAV_DTYPE)):
+        if contract.struct_dtype(struct, ffi) != dtype:
+            raise ImportError(f"pyins: struct {struct} of the header beside {lib_path} is not the one "
+                              f"pyins.contract read ({contract.HEADER_PATH}); {_REBUILD}.")
     if has_hooks:
         try:
             lib.pyins_t_sin  # noqa: B018  (the library may be built without hooks)
@@ -93,139 +105,33 @@ def _load():
 
 ffi, lib, LIBRARY_PATH, HAS_TEST_HOOKS, plant = _load()
 
-_PRIMITIVE = {"double": "<f8", "int64_t": "<i8", "int32_t": "<i4", "uint32_t": "<u4",
-              "uint64_t": "<u8", "uint8_t": "u1"}
+# The ABI's data contract (pyins.contract), re-exported under its old names:
+# the same objects, so `except native.SampleError` catches either engine's.
+SAMPLE_DTYPE = contract.SAMPLE_DTYPE
+OUTPUT_DTYPE = contract.OUTPUT_DTYPE
+NAV_DTYPE = contract.NAV_DTYPE
+CONFIG_FIELDS = contract.CONFIG_FIELDS
+VERTICAL_MODES = contract.VERTICAL_MODES
+CoreError = contract.CoreError
+ConfigError = contract.ConfigError
+SampleError = contract.SampleError
+SnapshotError = contract.SnapshotError
+PlantError = contract.PlantError
+make_samples = contract.make_samples
+_SAMPLE_REJECTED = contract.SAMPLE_REJECTED
+_as_float_array = contract.as_float_array
+_check_samples = contract.check_samples
 
 
 def _numpy_dtype(struct_name):
-    """The NumPy dtype with exactly the C struct's layout (names, offsets, size)."""
-    t = ffi.typeof(struct_name)
-    names, formats, offsets = [], [], []
-    for name, field in t.fields:
-        ft = field.type
-        if ft.kind == "array":
-            formats.append((np.dtype(_PRIMITIVE[ft.item.cname]), (ft.length,)))
-        else:
-            formats.append(np.dtype(_PRIMITIVE[ft.cname]))
-        names.append(name)
-        offsets.append(field.offset)
-    return np.dtype({"names": names, "formats": formats, "offsets": offsets,
-                     "itemsize": ffi.sizeof(t)})
-
-
-SAMPLE_DTYPE = _numpy_dtype("pyins_sample")
-#: Statuses that reject a sample (batch calls stop there; SampleError).
-_SAMPLE_REJECTED = (lib.PYINS_E_SAMPLE_NONFINITE, lib.PYINS_E_SAMPLE_SATURATED)
-OUTPUT_DTYPE = _numpy_dtype("pyins_output")
-#: The compact record (pyins_nav): OUTPUT_DTYPE's fields of the same names.
-NAV_DTYPE = _numpy_dtype("pyins_nav")
-CONFIG_FIELDS = tuple(name for name, _ in ffi.typeof("pyins_config").fields)
-
-VERTICAL_MODES = {"hold": 0, "free": 1}
-
-
-class CoreError(RuntimeError):
-    """A negative pyins_status returned by the C core."""
-
-    def __init__(self, code, where):
-        self.code = code
-        self.status_name = status_str(code).split(":")[0]
-        super().__init__(f"{where}: {status_str(code)}")
-
-
-class ConfigError(CoreError, ValueError):
-    """The core refused a configuration."""
-
-
-class SampleError(CoreError, ValueError):
-    """The core rejected a sample (NaN/Inf, or an increment at or beyond its
-    saturation limit); ``index`` is its position, ``outputs`` the records of
-    the samples handled before it (the state is after those)."""
-
-    def __init__(self, code, index, outputs):
-        self.index = index
-        self.outputs = outputs
-        super().__init__(code, f"sample {index} rejected ({index} samples before it were "
-                               f"accepted; the state is after them)")
-
-
-class SnapshotError(CoreError, ValueError):
-    """The core refused a snapshot blob; the state was left as it was."""
+    """The NumPy dtype with exactly the C struct's layout (of this binding's ffi)."""
+    return contract.struct_dtype(struct_name, ffi)
 
 
 def status_str(code):
+    """The library's own pyins_status_str (contract.status_str is its text
+    without the library)."""
     return ffi.string(lib.pyins_status_str(int(code))).decode()
-
-
-def _as_float_array(name, value, tail, contiguous=True):
-    """Check one input array: float64, shape (N,) + tail, C-contiguous
-    (unless ``contiguous`` is False: the caller copies it).
-
-    Plain Python sequences are converted; NumPy arrays must already be right
-    (cffi's from_buffer would reinterpret a wrong dtype silently).
-    """
-    if isinstance(value, np.ndarray):
-        a = value
-    else:
-        try:
-            a = np.asarray(value, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{name}: cannot be read as float64 numbers ({exc})") from None
-    if a.dtype != np.float64:
-        raise ValueError(f"{name}: dtype is {a.dtype}, expected float64 "
-                         f"(convert with .astype(numpy.float64))")
-    want = "(N,)" if not tail else f"(N, {', '.join(map(str, tail))})"
-    if a.ndim != 1 + len(tail) or a.shape[1:] != tail:
-        raise ValueError(f"{name}: shape is {a.shape}, expected {want}")
-    if contiguous and not a.flags.c_contiguous:
-        raise ValueError(f"{name}: array is not C-contiguous (use numpy.ascontiguousarray)")
-    return a
-
-
-def make_samples(dtheta_p_rad, dv_p_mps, table_angle_rad=None, seq=None):
-    """Pack per-field arrays into a SAMPLE_DTYPE array, checking each field.
-
-    dtheta_p_rad, dv_p_mps: (N, 3) float64 [rad], [m/s]; table_angle_rad:
-    (N,) float64 [rad] or None for a table fixed at 0; seq: (N,) integers,
-    the IMU's sample counter (taken modulo 2^32), or None for zeros. The core
-    reads seq only with ``seq_mode=1`` (PYINS_SEQ_CHECK) in its configuration;
-    logs without a counter leave it off. The fields are copied, so views
-    (a column slice of a log, every other row) are fine.
-    """
-    dtheta = _as_float_array("dtheta_p_rad", dtheta_p_rad, (3,), contiguous=False)
-    dv = _as_float_array("dv_p_mps", dv_p_mps, (3,), contiguous=False)
-    n = dtheta.shape[0]
-    if dv.shape[0] != n:
-        raise ValueError(f"dv_p_mps: has {dv.shape[0]} rows but dtheta_p_rad has {n}")
-    samples = np.zeros(n, dtype=SAMPLE_DTYPE)
-    samples["dtheta_p_rad"] = dtheta
-    samples["dv_p_mps"] = dv
-    if table_angle_rad is not None:
-        table = _as_float_array("table_angle_rad", table_angle_rad, (), contiguous=False)
-        if table.shape[0] != n:
-            raise ValueError(f"table_angle_rad: has {table.shape[0]} rows but dtheta_p_rad has {n}")
-        samples["table_angle_rad"] = table
-    if seq is not None:
-        counter = np.asarray(seq)
-        if counter.shape != (n,) or not np.issubdtype(counter.dtype, np.integer):
-            raise ValueError(f"seq: expected {n} integers, got dtype {counter.dtype} shape {counter.shape}")
-        samples["seq"] = counter.astype(np.int64) & 0xFFFFFFFF   # modulo 2^32, as the IMU's counter wraps
-    return samples
-
-
-def _check_samples(samples):
-    if (type(samples) is np.ndarray and samples.dtype is SAMPLE_DTYPE and samples.ndim == 1
-            and samples.flags.c_contiguous):
-        return samples          # the common case, checked in a few hundred ns
-    if not isinstance(samples, np.ndarray) or samples.dtype != SAMPLE_DTYPE:
-        got = samples.dtype if isinstance(samples, np.ndarray) else type(samples).__name__
-        raise ValueError(f"samples: expected an array of pyins.native.SAMPLE_DTYPE, got {got} "
-                         f"(build one with pyins.native.make_samples)")
-    if samples.ndim != 1:
-        raise ValueError(f"samples: shape is {samples.shape}, expected (N,)")
-    if not samples.flags.c_contiguous:
-        raise ValueError("samples: array is not C-contiguous (use numpy.ascontiguousarray)")
-    return samples
 
 
 def make_config(config=None, **fields):
@@ -238,39 +144,7 @@ def make_config(config=None, **fields):
     merged.update(fields)
     cfg = ffi.new("pyins_config *")
     lib.pyins_config_default(cfg)
-    for key, value in merged.items():
-        if key not in CONFIG_FIELDS:
-            raise ValueError(f"config: unknown key {key!r} (known: {', '.join(CONFIG_FIELDS)})")
-        if key == "vertical_mode" and isinstance(value, str):
-            if value not in VERTICAL_MODES:
-                raise ValueError(f"config: vertical_mode {value!r} is not one of {sorted(VERTICAL_MODES)}")
-            value = VERTICAL_MODES[value]
-        current = getattr(cfg, key)
-        if key == "index_steps":
-            steps = list(value)
-            if len(steps) > len(current):
-                raise ValueError(f"config: index_steps holds at most {len(current)} steps, got {len(steps)}")
-            for i, step in enumerate(steps):
-                try:
-                    stop, kind, angle = (step["stop_ticks"], step["kind"], step["angle_rad"]) \
-                        if isinstance(step, dict) else step
-                    current[i].stop_ticks, current[i].kind, current[i].angle_rad = stop, kind, angle
-                except (TypeError, ValueError, KeyError, OverflowError) as exc:
-                    raise ValueError(f"config: index_steps[{i}] must be (stop_ticks, kind, angle_rad): "
-                                     f"{exc}") from None
-            continue
-        if isinstance(current, ffi.CData):   # a fixed-length array field
-            arr = np.asarray(value, dtype=np.float64)
-            if arr.shape != (len(current),):
-                raise ValueError(f"config: {key} needs {len(current)} values, got shape {arr.shape}")
-            for i, v in enumerate(arr):
-                current[i] = float(v)
-        else:
-            try:
-                setattr(cfg, key, value)
-            except (TypeError, OverflowError) as exc:
-                raise ValueError(f"config: {key}={value!r}: {exc}") from None
-    return cfg
+    return contract.set_config_fields(cfg, merged)
 
 
 class Firmware:
@@ -286,8 +160,7 @@ class Firmware:
         status = lib.pyins_init(self._core, lib.pyins_core_size(), cfg)
         if status != 0:
             raise ConfigError(status, "pyins_init")
-        self.config = {name: getattr(cfg, name) for name in CONFIG_FIELDS
-                       if not isinstance(getattr(cfg, name), ffi.CData)}
+        self.config = contract.scalar_config(cfg)
 
     def _setup_memory(self):
         size = lib.pyins_core_size()
@@ -447,15 +320,6 @@ class Firmware:
                 raise SampleError(status, int(n_done[0]), outputs[: n_done[0]].copy())
             raise CoreError(status, "pyins_run")
         return outputs
-
-
-class PlantError(CoreError):
-    """``pyins_fil_run`` stopped at a rejected sample: ``outputs`` and
-    ``records`` are the kept records before it, ``n_done`` the ticks done."""
-
-    def __init__(self, code, where, n_done, outputs, records):
-        self.n_done, self.outputs, self.records = n_done, outputs, records
-        super().__init__(code, where)
 
 
 class Plant:
