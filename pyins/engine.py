@@ -8,35 +8,64 @@ constructor, ``step``, ``run``, ``snapshot``/``restore`` and records of
 ``native.OUTPUT_DTYPE``) and the NumPy mirror of the plant (`MirrorPlant`,
 over `pyins.sim.turntable`), about a thousand times slower. Everything above
 (runner, fil, runs, the CLI's ``--engine``) is the same code for both.
+
+The reference engine needs no compiled library: `pyins.native` is imported
+here once at module level, and a failure (no library built, a stale one) is
+kept: asking for the native engine then raises ImportError with the loader's
+message (`native_error`), while the reference engine goes on. The records,
+errors and samples of both are `pyins.contract`'s.
 """
 import json
 
 import numpy as np
 
-from pyins import native, reference
+from pyins import contract, reference
 from pyins.sim import turntable
 
+try:
+    from pyins import native
+except ImportError as _exc:   # no (or a stale) libpyins_core.so: the reference engine only
+    native = None
+    _NATIVE_ERROR = str(_exc)
+else:
+    _NATIVE_ERROR = None
+
 ENGINES = ("native", "reference")
-_FIRMWARE = {"native": native.Firmware, "reference": reference.Firmware}
+
+
+def native_error():
+    """None when the native engine is available, else why it is not (the
+    ImportError's message of `pyins.native`)."""
+    return _NATIVE_ERROR
 
 
 def check(engine):
     """``engine`` if it is one of ENGINES, else ValueError."""
-    if engine not in _FIRMWARE:
+    if engine not in ENGINES:
         raise ValueError(f"engine: {engine!r} is not one of {', '.join(ENGINES)}")
     return engine
 
 
+def _native():
+    """`pyins.native`, or ImportError saying why it could not be loaded."""
+    if native is None:
+        raise ImportError(f"engine 'native' is not available ({_NATIVE_ERROR}); "
+                          f"engine='reference' runs without the compiled library")
+    return native
+
+
 def firmware(engine, config):
     """A firmware instance of ``engine`` from a configuration dict."""
-    return _FIRMWARE[check(engine)](config)
+    if check(engine) == "native":
+        return _native().Firmware(config)
+    return reference.Firmware(config)
 
 
 def plant(engine, table, errors, record_dtype, alpha0=0.0):
     """The closed loop's plant of ``engine``: ``table`` a TableConfig,
     ``errors`` the plant's error matrices (turntable.error_matrices)."""
     if check(engine) == "native":
-        return native.Plant(table, errors, record_dtype, alpha0)
+        return _native().Plant(table, errors, record_dtype, alpha0)
     return MirrorPlant(table, errors, record_dtype, alpha0)
 
 
@@ -64,16 +93,16 @@ class MirrorPlant:
             # 2. the firmware's tick, and its motor command back to the plant
             try:
                 out = fw.step(g, a, enc, seq)
-            except native.SampleError as exc:
-                raise native.PlantError(exc.code, f"pyins_fil_run at tick {tick0 + k}", k,
-                                        self._kept(outs, native.OUTPUT_DTYPE),
-                                        self._kept(recs, self._record_dtype)) from None
+            except contract.SampleError as exc:
+                raise contract.PlantError(exc.code, f"pyins_fil_run at tick {tick0 + k}", k,
+                                          self._kept(outs, contract.OUTPUT_DTYPE),
+                                          self._kept(recs, self._record_dtype)) from None
             st.rate_cmd_rad_s = float(out["motor_rate_cmd_rad_s"])
             # 3. the kept records
             if st.tick % every == 0:
                 outs.append(out)
                 recs.append((st.tick, st.alpha_rad, st.rate_rad_s, enc))
-        return self._kept(outs, native.OUTPUT_DTYPE), self._kept(recs, self._record_dtype)
+        return self._kept(outs, contract.OUTPUT_DTYPE), self._kept(recs, self._record_dtype)
 
     @staticmethod
     def _kept(rows, dtype):

@@ -10,12 +10,16 @@ compact record), ``pyins_get_output``, ``pyins_get_nav`` and
 :class:`Firmware` is the reference engine: the contract of
 ``pyins.native.Firmware`` (the same constructor, ``step``, ``run``,
 ``run_nav``, ``nav``, ``output``, ``index_reset``, ``snapshot``/``restore``, ``last_status`` and
-``config``), the same exceptions (``native.ConfigError``,
-``native.SampleError``, ``native.SnapshotError``, ``native.CoreError``) and
-records of ``native.OUTPUT_DTYPE``, so that a caller swaps
-``engine="native"|"reference"`` without another line. The configuration is
-read by ``native.make_config`` (the C struct's fields, types and defaults)
-and handed to the mirror as a dict.
+``config``), the same exceptions (``contract.ConfigError``,
+``contract.SampleError``, ``contract.SnapshotError``, ``contract.CoreError``,
+which ``pyins.native`` re-exports) and records of ``contract.OUTPUT_DTYPE``,
+so that a caller swaps ``engine="native"|"reference"`` without another line.
+The configuration is the mirror's own defaults (``config.config_default``)
+with the caller's fields written over them by ``contract.set_config_fields``
+(the C struct's names, shapes and types, the checks ``native.make_config``
+applies), then handed to the mirror as a dict: nothing here loads the
+compiled library, and a drift of the defaults between the twins shows
+(tests/native/test_contract.py).
 
 Records of the two engines agree in every integer field and to a few ulps
 in the floats (portable vs libm sin/cos, Eigen vs NumPy summation order),
@@ -31,8 +35,9 @@ import pickle
 
 import numpy as np
 
-from .. import native
+from .. import contract
 from . import abi, config, firmware
+from .config import config_default
 
 #: The header of a reference snapshot: magic, then the SHA-256 of the payload.
 SNAP_MAGIC = b"PYRS\x01\x00\x00\x00"
@@ -40,16 +45,39 @@ _SNAP_HEADER = len(SNAP_MAGIC) + 32
 
 
 def config_from_struct(cfg):
-    """A ``pyins_config`` (cffi) as the mirror's configuration dict."""
+    """A ``pyins_config`` (cffi, of either engine's FFI) as the mirror's
+    configuration dict."""
     out = {}
-    for name in native.CONFIG_FIELDS:
+    for name in contract.CONFIG_FIELDS:
         value = getattr(cfg, name)
         if name == "index_steps":
             value = [(s.stop_ticks, s.kind, s.angle_rad) for s in value]
-        elif isinstance(value, native.ffi.CData):
+        elif isinstance(value, contract.ffi.CData):
             value = np.array(list(value), dtype=np.float64)
         out[name] = value
     return out
+
+
+def struct_from_config(cfg):
+    """The mirror's configuration dict as a ``pyins_config *`` (of the
+    contract's FFI; fields the dict lacks stay 0)."""
+    struct = contract.ffi.new("pyins_config *")
+    return contract.set_config_fields(struct, cfg)
+
+
+def make_config(config=None, **fields):   # the parameter shadows the module here, as in native
+    """The reference twin of ``native.make_config``: a ``pyins_config *``
+    (contract's FFI) holding the mirror's defaults (``config.config_default``)
+    and the caller's fields over them, with the same checks and messages
+    (unknown key, shape, type; ``vertical_mode`` 'hold' / 'free')."""
+    merged = dict(config or {})
+    merged.update(fields)
+    return contract.set_config_fields(struct_from_config(config_default()), merged)
+
+
+def pyins_status_str(status):
+    """Mirrors pyins_status_str (c_api.cpp): the contract's text."""
+    return contract.status_str(status)
 
 
 def pyins_init(raw):
@@ -131,7 +159,7 @@ def _records(status, n_done, records, dtype):
     for rec, o in zip(out, records):
         fill(rec, o)
     if status != abi.PYINS_OK:
-        raise native.SampleError(status, n_done, out)
+        raise contract.SampleError(status, n_done, out)
     return out
 
 
@@ -150,18 +178,17 @@ class Firmware:
 
     >>> fw = Firmware(lat_rad=0.5, euler_b_rad=[0, 0, 1.0])
     >>> rec = fw.step([0, 0, 0], [0, 0, 0.098])        # one OUTPUT_DTYPE record
-    >>> out = fw.run(native.make_samples(dtheta, dv))   # doctest: +SKIP
+    >>> out = fw.run(contract.make_samples(dtheta, dv))   # doctest: +SKIP
     """
 
     def __init__(self, config=None, **fields):
-        cfg = native.make_config(config, **fields)
+        cfg = make_config(config, **fields)
         status, fw = pyins_init(config_from_struct(cfg))
         if status != abi.PYINS_OK:
-            raise native.ConfigError(status, "pyins_init")
+            raise contract.ConfigError(status, "pyins_init")
         self._fw = fw
         self.last_status = abi.PYINS_OK
-        self.config = {name: getattr(cfg, name) for name in native.CONFIG_FIELDS
-                       if not isinstance(getattr(cfg, name), native.ffi.CData)}
+        self.config = contract.scalar_config(cfg)
 
     @property
     def instance(self):
@@ -170,7 +197,7 @@ class Firmware:
 
     def output(self):
         """The current state as one OUTPUT_DTYPE record."""
-        out = np.zeros(1, dtype=native.OUTPUT_DTYPE)
+        out = np.zeros(1, dtype=contract.OUTPUT_DTYPE)
         pyins_get_output(self._fw, out[0])
         return out[0].copy()
 
@@ -179,15 +206,15 @@ class Firmware:
         a PYINS_W_* notice is kept in ``last_status``."""
         dtheta = _vector3("dtheta_p_rad", dtheta_p_rad)
         dv = _vector3("dv_p_mps", dv_p_mps)
-        out = np.zeros(1, dtype=native.OUTPUT_DTYPE)
+        out = np.zeros(1, dtype=contract.OUTPUT_DTYPE)
         status = pyins_step(self._fw, dtheta, dv, float(table_angle_rad), int(seq) & 0xFFFFFFFF, out[0])
         self.last_status = status
         if status < 0:
-            raise native.SampleError(status, 0, np.zeros(0, dtype=native.OUTPUT_DTYPE))
+            raise contract.SampleError(status, 0, np.zeros(0, dtype=contract.OUTPUT_DTYPE))
         return out[0].copy()
 
     def run(self, samples, outputs=None, every=1):
-        """Step through a SAMPLE_DTYPE array (see ``native.Firmware.run``):
+        """Step through a SAMPLE_DTYPE array (see ``pyins.native.Firmware.run``):
         one record per sample, or with ``every=k`` one record after each
         step whose tick is a multiple of k; SampleError at the first
         rejected sample, carrying the records before it."""
@@ -197,17 +224,17 @@ class Firmware:
             every = int(every)
             if every < 1:
                 raise ValueError(f"every: must be a positive number of ticks, got {every}")
-            return _records(*pyins_run_decimated(self._fw, samples, every), native.OUTPUT_DTYPE)
+            return _records(*pyins_run_decimated(self._fw, samples, every), contract.OUTPUT_DTYPE)
         if outputs is None:
-            outputs = np.zeros(n, dtype=native.OUTPUT_DTYPE)
-        elif (not isinstance(outputs, np.ndarray) or outputs.dtype != native.OUTPUT_DTYPE
+            outputs = np.zeros(n, dtype=contract.OUTPUT_DTYPE)
+        elif (not isinstance(outputs, np.ndarray) or outputs.dtype != contract.OUTPUT_DTYPE
               or outputs.shape != (n,) or not outputs.flags.c_contiguous
               or not outputs.flags.writeable):
             raise ValueError("outputs: expected a writeable C-contiguous OUTPUT_DTYPE array "
                              f"of shape ({n},)")
         status, n_done = pyins_run(self._fw, samples, outputs)
         if status != abi.PYINS_OK:
-            raise native.SampleError(status, n_done, outputs[:n_done].copy())
+            raise contract.SampleError(status, n_done, outputs[:n_done].copy())
         return outputs
 
     def run_nav(self, samples, every=1):
@@ -216,11 +243,11 @@ class Firmware:
         every = int(every)
         if every < 1:
             raise ValueError(f"every: must be a positive number of ticks, got {every}")
-        return _records(*pyins_run_nav(self._fw, samples, every), native.NAV_DTYPE)
+        return _records(*pyins_run_nav(self._fw, samples, every), contract.NAV_DTYPE)
 
     def nav(self):
         """The current state as one NAV_DTYPE record."""
-        out = np.zeros(1, dtype=native.NAV_DTYPE)
+        out = np.zeros(1, dtype=contract.NAV_DTYPE)
         pyins_get_nav(self._fw, out[0])
         return out[0].copy()
 
@@ -240,18 +267,18 @@ class Firmware:
             raise ValueError(f"snapshot: expected bytes, got {type(blob).__name__}")
         blob = bytes(blob)
         if len(blob) < _SNAP_HEADER:
-            raise native.SnapshotError(abi.PYINS_E_SNAPSHOT_SIZE, "pyins_restore")
+            raise contract.SnapshotError(abi.PYINS_E_SNAPSHOT_SIZE, "pyins_restore")
         if blob[:len(SNAP_MAGIC)] != SNAP_MAGIC:
             status = (abi.PYINS_E_SNAPSHOT_VERSION if blob[:4] == SNAP_MAGIC[:4]
                       else abi.PYINS_E_SNAPSHOT_CORRUPT)
-            raise native.SnapshotError(status, "pyins_restore")
+            raise contract.SnapshotError(status, "pyins_restore")
         payload = blob[_SNAP_HEADER:]
         if hashlib.sha256(payload).digest() != blob[len(SNAP_MAGIC):_SNAP_HEADER]:
-            raise native.SnapshotError(abi.PYINS_E_SNAPSHOT_CORRUPT, "pyins_restore")
+            raise contract.SnapshotError(abi.PYINS_E_SNAPSHOT_CORRUPT, "pyins_restore")
         try:
             fw, last_status, cfg = _StateUnpickler(io.BytesIO(payload)).load()
         except (pickle.UnpicklingError, ValueError, TypeError, EOFError) as exc:
-            raise native.SnapshotError(abi.PYINS_E_SNAPSHOT_CORRUPT, f"pyins_restore ({exc})") from None
+            raise contract.SnapshotError(abi.PYINS_E_SNAPSHOT_CORRUPT, f"pyins_restore ({exc})") from None
         self._fw, self.last_status, self.config = fw, last_status, cfg
 
     @classmethod
@@ -270,10 +297,5 @@ def _vector3(name, value):
 
 
 def _check_samples(samples):
-    if not isinstance(samples, np.ndarray) or samples.dtype != native.SAMPLE_DTYPE:
-        got = samples.dtype if isinstance(samples, np.ndarray) else type(samples).__name__
-        raise ValueError(f"samples: expected an array of pyins.native.SAMPLE_DTYPE, got {got} "
-                         f"(build one with pyins.native.make_samples)")
-    if samples.ndim != 1:
-        raise ValueError(f"samples: shape is {samples.shape}, expected (N,)")
-    return samples
+    # the contract's check; this engine reads rows, so views need not be contiguous
+    return contract.check_samples(samples, contiguous=False)
