@@ -14,17 +14,18 @@ kalman::Mat<N, N> system_matrix(double sin_lat, double cos_lat) {
     const double w_n = earth::kOmegaIe * cos_lat;
     const double w_u = earth::kOmegaIe * sin_lat;
     kalman::Mat<N, N> f = kalman::Mat<N, N>::Zero();
-    f(0, 1) = w_u;
-    f(0, 2) = -w_n;
-    f(1, 0) = -w_u;
-    f(2, 0) = w_n;
+    // phi' = phi x w_ie - eps, w_ie = [0, w_N, w_U]
+    f(kPhi + 0, kPhi + 1) = w_u;
+    f(kPhi + 0, kPhi + 2) = -w_n;
+    f(kPhi + 1, kPhi + 0) = -w_u;
+    f(kPhi + 2, kPhi + 0) = w_n;
     if constexpr (N == 8) {
-        f(0, 3) = -1.0;   // eps_E
-        f(1, 4) = -1.0;   // eps_N
-        f(2, 5) = -1.0;   // eps_U
+        f(kPhi + 0, kEps + 0) = -1.0;
+        f(kPhi + 1, kEps + 1) = -1.0;
+        f(kPhi + 2, kEps + 2) = -1.0;
     } else {
-        f(1, 3) = -1.0;   // eps_N^
-        f(2, 4) = -1.0;   // eps_U^
+        f(kPhi + 1, kEpsNU + 0) = -1.0;
+        f(kPhi + 2, kEpsNU + 1) = -1.0;
     }
     return f;
 }
@@ -64,35 +65,36 @@ void init(FineAlign<N>& f, const Params& prm) {
     f.phi = kalman::Mat<N, N>::Identity() + ft + 0.5 * (ft * ft);
     f.qd = kalman::Mat<N, N>::Zero();
     const double q_att = prm.gyro_arw * prm.gyro_arw * prm.dt;
-    f.qd(0, 0) = q_att;
-    f.qd(1, 1) = q_att;
-    f.qd(2, 2) = q_att;
+    f.qd(kPhi + 0, kPhi + 0) = q_att;
+    f.qd(kPhi + 1, kPhi + 1) = q_att;
+    f.qd(kPhi + 2, kPhi + 2) = q_att;
 
     const double g = prm.gravity;
     f.h = kalman::Mat<2, N>::Zero();
-    f.h(0, 1) = -g;
-    f.h(1, 0) = g;
+    // Z = [f_E f_N] = [-g phi_N + nabla_E, g phi_E + nabla_N]
+    f.h(0, kPhi + 1) = -g;
+    f.h(1, kPhi + 0) = g;
     if constexpr (N == 8) {
-        f.h(0, 6) = 1.0;  // nabla_E
-        f.h(1, 7) = 1.0;  // nabla_N
+        f.h(0, kNabla + 0) = 1.0;
+        f.h(1, kNabla + 1) = 1.0;
     }
     const double r = prm.accel_vrw * prm.accel_vrw / (static_cast<double>(prm.meas_every) * prm.dt);
     f.r << r, 0.0,
            0.0, r;
 
     kalman::Vec<N> sigma;
-    sigma(0) = prm.sigma0_att[0];
-    sigma(1) = prm.sigma0_att[1];
-    sigma(2) = prm.sigma0_att[2];
+    sigma(kPhi + 0) = prm.sigma0_att[0];
+    sigma(kPhi + 1) = prm.sigma0_att[1];
+    sigma(kPhi + 2) = prm.sigma0_att[2];
     if constexpr (N == 8) {
-        sigma(3) = prm.sigma0_gyro;
-        sigma(4) = prm.sigma0_gyro;
-        sigma(5) = prm.sigma0_gyro;
-        sigma(6) = prm.sigma0_accel;
-        sigma(7) = prm.sigma0_accel;
+        sigma(kEps + 0) = prm.sigma0_gyro;
+        sigma(kEps + 1) = prm.sigma0_gyro;
+        sigma(kEps + 2) = prm.sigma0_gyro;
+        sigma(kNabla + 0) = prm.sigma0_accel;
+        sigma(kNabla + 1) = prm.sigma0_accel;
     } else {
-        sigma(3) = prm.sigma0_gyro;
-        sigma(4) = prm.sigma0_gyro;
+        sigma(kEpsNU + 0) = prm.sigma0_gyro;
+        sigma(kEpsNU + 1) = prm.sigma0_gyro;
     }
     f.p = kalman::Mat<N, N>::Zero();
     for (int i = 0; i < N; ++i) {

@@ -65,6 +65,13 @@ struct Params {
     double nis_max;          ///< bound on a window's mean NIS
 };
 
+/// State indices, the layouts above (the mirror's PHI, EPS, NABLA, EPS_NU),
+/// in the order the output record's kf_x and kf_sigma hold them.
+inline constexpr int kPhi = 0;     ///< phi_E, phi_N, phi_U (both; the 5-state's transformed phi^)
+inline constexpr int kEps = 3;     ///< eps_E, eps_N, eps_U (8-state)
+inline constexpr int kNabla = 6;   ///< nabla_E, nabla_N (8-state)
+inline constexpr int kEpsNU = 3;   ///< eps_N^, eps_U^ (5-state)
+
 template <int N>
 struct FineAlign {
     static_assert(N == 5 || N == 8, "the 5-state or the 8-state filter");
@@ -120,15 +127,15 @@ bool step(FineAlign<N>& f, const Vec3& dv_sf_n);
 /// The attitude error estimate phi^ (E, N, U) [rad].
 template <int N>
 Vec3 phi(const FineAlign<N>& f) {
-    return Vec3(f.x(0), f.x(1), f.x(2));
+    return Vec3(f.x(kPhi + 0), f.x(kPhi + 1), f.x(kPhi + 2));
 }
 
 /// After feeding phi^ back into the attitude: phi^ = 0.
 template <int N>
 void reset_phi(FineAlign<N>& f) {
-    f.x(0) = 0.0;
-    f.x(1) = 0.0;
-    f.x(2) = 0.0;
+    f.x(kPhi + 0) = 0.0;
+    f.x(kPhi + 1) = 0.0;
+    f.x(kPhi + 2) = 0.0;
 }
 
 extern template struct FineAlign<5>;
