@@ -26,8 +26,8 @@ import time
 
 import numpy as np
 
-from pyins import (__version__, bench, campaign, engine, logs, metrics, native, replay, replay_options, report,
-                   runner, runs, scenario, sim, truth_track)
+from pyins import (__version__, bench, budget, campaign, engine, logs, metrics, native, replay, replay_options,
+                   report, runner, runs, scenario, sim, truth_track)
 from pyins.progress import Phases, TextProgress, phase
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, TICK_HZ
 
@@ -414,9 +414,8 @@ def cmd_campaign(args):
 
 def cmd_budget(args):
     """Each sensor error's signed share of a scenario's errors: the linear model of
-    pyins.analysis.run_budget on one closed-loop run per variant; --check runs every
+    pyins.budget.run_budget on one closed-loop run per variant; --check runs every
     source alone through the firmware too (docs/concepts.md, "The error budget")."""
-    from pyins import analysis
     scn = scenario.load(args.scenario)
     overrides = _set_overrides(args)
     if overrides:
@@ -431,17 +430,17 @@ def cmd_budget(args):
     for spec in specs:
         _say(args, f"pyins budget {scn.name} [{spec.label}], {spec.duration_ticks / _TICKS_PER_HOUR:g} h"
                    + (", every source alone too" if args.check else ""))
-        rows, budget = analysis.run_budget(spec, check=args.check)
+        rows, shares = budget.run_budget(spec, check=args.check)
         for r in rows:
             line = (f"  {r['source']:19s} model N {r['model_north_m'] / NMI_TO_M:+8.3f}  "
                     f"E {r['model_east_m'] / NMI_TO_M:+8.3f}  final {r['model_final_m'] / NMI_TO_M:7.3f} nmi")
             if "fil_final_m" in r:
                 line += (f"   FIL N {r['fil_north_m'] / NMI_TO_M:+8.3f}  E {r['fil_east_m'] / NMI_TO_M:+8.3f}"
                          f"  final {r['fil_final_m'] / NMI_TO_M:7.3f} nmi  rel. diff. "
-                         f"{analysis.budget_verdict(r)[1]}")
+                         f"{budget.budget_verdict(r)[1]}")
             _say(args, line)
         result.append(dict(label=spec.label, rows=rows,
-                           eps_n_mean_rad_s={n: budget.eps_n_mean[i].tolist() for i, n in enumerate(budget.names)}))
+                           eps_n_mean_rad_s={n: shares.eps_n_mean[i].tolist() for i, n in enumerate(shares.names)}))
     _emit_json(args, dict(scenario=scn.name, variants=result))
     return EXIT_OK
 

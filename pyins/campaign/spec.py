@@ -45,6 +45,7 @@ from pyins import scenario as scenario_mod
 from pyins.campaign.grid import (canonical, compile_formula, eval_formula, formula_names,
                                  number_as_written, parse_grid, parse_overrides, parse_seeds, qkey,
                                  show, value_label)
+from pyins.sim import sensors
 from pyins.units import ScenarioError
 
 __all__ = ["Campaign", "Point", "load_campaign", "loads_campaign", "from_args", "list_builtin",
@@ -165,7 +166,6 @@ def _rewrap(exc, key, source, prefix=""):
 def _check_random_constants(preset, grid, fixed, seeds, source):
     """``random_constants``: a sensor preset; needs seeds (the draws); the
     campaign may not set the terms it draws."""
-    from pyins.sim import sensors
     where = "campaign.random_constants"
     if not isinstance(preset, str) or preset not in sensors.PRESETS:
         close = difflib.get_close_matches(str(preset), list(sensors.PRESETS), n=1)
@@ -374,7 +374,6 @@ def _drawn(preset, run, _cache={}):
     """The overrides of draw ``run`` of ``preset`` (cached: one per draw, not per point)."""
     key = (preset, run)
     if key not in _cache:
-        from pyins.sim import sensors
         _cache[key] = {"sensors.preset": preset, **sensors.random_constant_overrides(preset, run)}
     return copy.deepcopy(_cache[key])
 

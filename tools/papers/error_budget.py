@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The error budget of seeds 002 and 003: each sensor error's signed share of
-the position error, by the linear error model (pyins.analysis.run_budget)
+the position error, by the linear error model (pyins.budget.run_budget)
 and by the firmware in the loop with that error alone.
 
     .venv/bin/python tools/papers/error_budget.py [--out runs/error_budget] [--hours H]
@@ -32,7 +32,7 @@ import os
 import sys
 import time
 
-from pyins import analysis, scenario
+from pyins import budget as error_budget, scenario
 from pyins.units import DPH_TO_RPS, NMI_TO_M, TICK_HZ
 
 LABELS = {"gyro_bias": "gyro bias", "gyro_scale": "gyro scale factor",
@@ -46,8 +46,8 @@ def fmt_nmi(m):
     return f"{m / NMI_TO_M:+.3f}"
 
 
-FLOOR_M = analysis.BUDGET_FLOOR_M     #: below it a run is judged in metres (analysis.budget_verdict)
-judged = analysis.budget_verdict
+FLOOR_M = error_budget.BUDGET_FLOOR_M     #: below it a run is judged in metres (pyins.budget.budget_verdict)
+judged = error_budget.budget_verdict
 
 
 def table_rows(scheme, rows, check):
@@ -153,12 +153,12 @@ def main(argv=None):
             for spec in sc.with_overrides({**overrides, **over}).runs():
                 t0 = time.time()
                 if deck == "tilted":
-                    rows, budget = analysis.run_budget(spec, check=check)
+                    rows, budget = error_budget.run_budget(spec, check=check)
                 else:                    # the gyro misalignment alone, no initial errors: its "sum" row
-                    only = analysis.deterministic(spec.errors)
+                    only = error_budget.deterministic(spec.errors)
                     spec.errors = type(only)(gyro_misalignment=only.gyro_misalignment)
-                    spec.config = {k: v for k, v in spec.config.items() if k not in analysis._INITIAL_FIELDS}
-                    rows, budget = analysis.run_budget(spec, check=False)
+                    spec.config = {k: v for k, v in spec.config.items() if k not in error_budget._INITIAL_FIELDS}
+                    rows, budget = error_budget.run_budget(spec, check=False)
                 eps_u = {n: float(budget.eps_n_mean[i, 2] / DPH_TO_RPS) for i, n in enumerate(budget.names)}
                 out["runs"].append(dict(scenario=name, deck=deck, scheme=spec.label, mis_table=len(decks) > 1,
                                         hours=spec.duration_ticks / TICK_HZ / 3600, rows=rows,
