@@ -18,7 +18,8 @@ errors, files. One room per concept:
   sample instants (`truth`), and a chunked run generator (`generate`).
 - `pyins.sim.sensors`: bias, scale factor, misalignment, random walk and
   quantisation (`SensorErrors`, `SensorModel`, `preset`).
-- `pyins.sim.io`: .npz and CSV sample files.
+- `pyins.sim.io`: .npz and CSV sample files (the format is
+  `pyins.logs.project`'s; the names stay importable from here).
 
 Frames and units as in ``pyins`` (docs/design.md §2): n = ENU, b = x
 starboard / y bow / z up, p = IMU on the turntable with C_p^b = Rz(alpha);
