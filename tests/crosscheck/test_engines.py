@@ -15,7 +15,7 @@ the same bit for bit run after run and across a snapshot.
 import numpy as np
 import pytest
 
-from pyins import native
+from pyins import engine, native
 from pyins import reference
 from pyins.reference import abi, earth
 from pyins import units
@@ -151,3 +151,21 @@ def test_snapshot_and_index_reset():
         assert fw.run(s[800:]).tobytes() == whole[800:].tobytes()
         with pytest.raises(native.SnapshotError):
             fw.restore(blob[:-1] + bytes([blob[-1] ^ 1]))
+
+
+def test_engine_choice_and_a_missing_native_engine(monkeypatch):
+    """pyins.engine picks the class by name; without pyins.native (no
+    library: engine.native is None) the reference engine still runs and the
+    native one raises ImportError saying why (tests/reference/test_no_library.py
+    does it with the library really absent)."""
+    assert type(engine.firmware("native", CFG)) is native.Firmware
+    assert type(engine.firmware("reference", CFG)) is reference.Firmware
+    with pytest.raises(ValueError, match="is not one of native, reference"):
+        engine.firmware("numba", CFG)
+    monkeypatch.setattr(engine, "native", None)
+    monkeypatch.setattr(engine, "_NATIVE_ERROR", "pyins: no library here")
+    assert type(engine.firmware("reference", CFG)) is reference.Firmware
+    with pytest.raises(ImportError, match=r"engine 'native' is not available \(pyins: no library here\)"):
+        engine.firmware("native", CFG)
+    with pytest.raises(ImportError, match="not available"):
+        engine.plant("native", None, None, None)
