@@ -7,9 +7,9 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from pyins import logs
+from pyins.logs import ImuData
 from pyins.units import DEG_TO_RAD
-from pyins.sim import imu, io, motion, sensors, turntable
-from pyins.sim.io import ImuData
+from pyins.sim import imu, motion, sensors, turntable
 from strategies import finite
 
 LAT = 34.246 * DEG_TO_RAD
@@ -412,7 +412,7 @@ def test_binary_nan_and_time(tmp_path):
 
 def test_project_formats_errors_are_log_errors(tmp_path):
     path = tmp_path / "bad.csv"
-    path.write_text(io.CSV_HEADER + "\n1,1,2,x3,4,5,6,7\n")
+    path.write_text(logs.CSV_HEADER + "\n1,1,2,x3,4,5,6,7\n")
     expect_error(path, "line 2, column 4 (dtheta_z_rad)", "not a number")
     path = tmp_path / "bad.npz"
     np.savez(path, dtheta_p=np.zeros((3, 3)))

@@ -1,8 +1,9 @@
-"""The readers users have (issue 14 defect 4): PSINS's .imu, CSV with named
-columns, compressed files (gzip, xz, bzip2, by extension and by magic bytes),
-pulse counts with a scale factor in arcsec and ug*s; each bad input refused in
-one line naming the file, the line or record and what was expected; and a log
-with a missing sample replayed with --allow-gaps (defect 8)."""
+"""The readers users have (docs/log-formats.md, "Formats"): PSINS's .imu,
+CSV with named columns, compressed files (gzip, xz, bzip2, by extension and by
+magic bytes), pulse counts with a scale factor in arcsec and ug*s; each bad
+input refused in one line naming the file, the line or record and what was
+expected; and a log with a missing sample replayed with --allow-gaps
+(docs/log-formats.md, "Gaps in the CLI")."""
 import bz2
 import gzip
 import json
@@ -14,7 +15,7 @@ import pytest
 from pyins import __main__ as cli
 from pyins import logs
 from pyins.sim import imu, motion
-from pyins.sim.io import ImuData
+from pyins.logs import ImuData
 from pyins.units import ARCSEC_TO_RAD, DEG_TO_RAD, UG_TO_MPS2
 
 LAT, LON = 34.246, 108.91

@@ -1,9 +1,9 @@
-"""A real recorded log through the front door (issue 14, "Real data in the
-tests"): the first 300 s of PSINS's data/lasergyro.imu (tests/data/README.md),
-a ring-laser-gyro IMU in a parked vehicle at 34.246 N, read by the PSINS
-reader, replayed through the CLI, its coarse alignment checked against an
-independent inertial-frame alignment written here, and the same records
-rewritten into every layout the readers take."""
+"""A real recorded log through the front door, so that the tests hold data
+the simulator did not make: the first 300 s of PSINS's data/lasergyro.imu
+(tests/data/README.md), a ring-laser-gyro IMU in a parked vehicle at
+34.246 N, read by the PSINS reader, replayed through the CLI, its coarse
+alignment checked against an independent inertial-frame alignment written
+here, and the same records rewritten into every layout the readers take."""
 import bz2
 import gzip
 import json
@@ -15,7 +15,7 @@ import pytest
 
 from pyins import __main__ as cli
 from pyins import logs
-from pyins.sim.io import ImuData
+from pyins.logs import ImuData
 from pyins.units import ARCSEC_TO_RAD, DEG_TO_RAD, DPH_TO_RPS
 
 LOG = os.path.join(os.path.dirname(__file__), os.pardir, "data", "lasergyro_300s.imu.gz")

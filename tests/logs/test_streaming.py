@@ -1,10 +1,10 @@
-"""Logs in blocks (issue 14, defect 9): `pyins.logs.LogReader` gives what
-`read_log` gives, bit for bit, whatever the block size, with the same errors
-naming the same lines across block boundaries; `LogWriter` writes the file
-`write_log` writes, and a kill leaves no file that looks complete; `pyins
-replay` in small blocks writes the records of one firmware call; Ctrl-C
-between blocks leaves a summary that says so; the memory of a streamed
-replay does not grow with the log."""
+"""Logs in blocks (docs/log-formats.md, "Reading and writing in blocks"):
+`pyins.logs.LogReader` gives what `read_log` gives, bit for bit, whatever the
+block size, with the same errors naming the same lines across block
+boundaries; `LogWriter` writes the file `write_log` writes, and a kill leaves
+no file that looks complete; `pyins replay` in small blocks writes the
+records of one firmware call; Ctrl-C between blocks leaves a summary that
+says so; the memory of a streamed replay does not grow with the log."""
 import gzip
 import json
 import os
@@ -19,7 +19,7 @@ import pytest
 
 from pyins import __main__ as cli
 from pyins import logs, replay, scenario
-from pyins.sim.io import ImuData
+from pyins.logs import ImuData
 from pyins.units import DEG_TO_RAD
 
 from test_logs import assert_same_data, static_log
@@ -240,7 +240,7 @@ def test_an_error_or_a_kill_mid_write_leaves_no_file_that_looks_complete(tmp_pat
             raise RuntimeError("stop")
     assert target.read_bytes() == b"the user's old file" and os.listdir(tmp_path) == ["log.bin"]
     # a kill (os._exit: no cleanup at all) after a block: the name is not written
-    code = ("import numpy as np, os; from pyins import logs; from pyins.sim.io import ImuData; "
+    code = ("import numpy as np, os; from pyins import logs; from pyins.logs import ImuData; "
             "d = ImuData(np.arange(1, 11), np.zeros((10, 3)), np.zeros((10, 3)), np.zeros(10), 0.01, {}); "
             f"w = logs.LogWriter({str(tmp_path / 'new.txt')!r}); w.write(d); os._exit(9)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 9

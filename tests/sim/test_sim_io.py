@@ -1,7 +1,11 @@
-"""IMU sample files: bit-exact round trips and clear errors on malformed input."""
+"""IMU sample files: bit-exact round trips and clear errors on malformed input,
+through `pyins.sim.io`, the names users have imported (the format itself is
+`pyins.logs.project`)."""
 import numpy as np
 import pytest
 
+from pyins import logs, sim
+from pyins.logs import project
 from pyins.sim import imu, io, motion, turntable
 
 
@@ -112,3 +116,11 @@ def test_save_rejects_bad_arrays(tmp_path):
     with pytest.raises(ValueError, match="not strictly increasing"):
         io.save_npz(tmp_path / "out.npz", np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3),
                     0.01, tick=[1, 3, 2])
+
+
+def test_the_simulators_names_are_the_log_formats():
+    """pyins.sim.io and pyins.sim keep the names of the file format that moved
+    to pyins.logs.project: the same objects, not copies."""
+    for name in io.__all__:
+        assert getattr(io, name) is getattr(project, name) is getattr(logs, name)
+        assert getattr(sim, name) is getattr(project, name)
