@@ -10,7 +10,6 @@ the venv's site-packages (NumPy, cffi): ``pyins`` is the copy, importing
 those of the same run in this process, bit for bit: the reference engine
 reads nothing from the library (its defaults included).
 """
-import dataclasses
 import os
 import shutil
 import subprocess
@@ -109,12 +108,14 @@ def test_a_reference_run_without_the_library_is_the_same_run_with_it(no_library,
 
 
 RUN_SCENARIO = textwrap.dedent("""
-    import dataclasses, sys
+    import sys
     import numpy as np
     from pyins import scenario
-    spec = dataclasses.replace(next(iter(scenario.load("demo").runs())), duration_ticks=300, every=100)
-    from pyins import runs
-    np.save(sys.argv[1], runs.run(spec, engine="reference").outputs)
+    spec = next(iter(scenario.load("demo").runs()))
+    from pyins import fil
+    res = fil.run_fil(spec.motion, 300, config=spec.config, errors=spec.errors, seed=spec.seed,
+                      table=spec.table, every=100, dt=spec.dt, engine="reference")
+    np.save(sys.argv[1], res.outputs)
 """)
 
 
@@ -132,8 +133,8 @@ def _blocking_chain(stderr):
 
 
 def test_a_builtin_scenario_runs_on_the_reference_engine_without_the_library(no_library, tmp_path):
-    """300 ticks of the built-in 'demo' through pyins.runs.run(engine='reference')
-    (the closed loop over the NumPy plant). Expected to fail while the
+    """300 ticks of the built-in 'demo' through pyins.fil.run_fil(engine='reference')
+    (the closed loop over the NumPy plant, what a scenario run calls). Expected to fail while the
     scenario's build imports pyins.native for the firmware's configuration
     check (pyins/scenario/build.py, pyins/limits.py: pyins_config_check);
     the xfail names the chain it met."""
@@ -145,6 +146,8 @@ def test_a_builtin_scenario_runs_on_the_reference_engine_without_the_library(no_
     assert proc.returncode == 0, proc.stderr
     away = np.load(out)
     # here, not at the top: the scenario path is this test's alone (and in flux)
-    from pyins import runs, scenario   # noqa: PLC0415
-    spec = dataclasses.replace(next(iter(scenario.load("demo").runs())), duration_ticks=300, every=100)
-    assert away.tobytes() == runs.run(spec, engine="reference").outputs.tobytes()
+    from pyins import fil, scenario   # noqa: PLC0415
+    spec = next(iter(scenario.load("demo").runs()))
+    here = fil.run_fil(spec.motion, 300, config=spec.config, errors=spec.errors, seed=spec.seed,
+                       table=spec.table, every=100, dt=spec.dt, engine="reference").outputs
+    assert away.shape == (3,) and away.tobytes() == here.tobytes()
