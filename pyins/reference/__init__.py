@@ -10,7 +10,11 @@ mirror: NumPy's own sin/cos/atan2 stand in for the core's portable ones.
 
 ``Firmware`` (from ``c_api``) is the reference engine: the contract of
 ``pyins.native.Firmware`` over this mirror, so that a caller chooses
-``engine="native"`` or ``"reference"`` and nothing else changes.
+``engine="native"`` or ``"reference"`` and nothing else changes. Nothing
+here imports ``pyins.native`` or needs the compiled library: the record
+dtypes, errors and sample checks are ``pyins.contract``'s (the ones
+``pyins.native`` re-exports), the configuration defaults ``config``'s own
+(tests/reference/test_no_library.py runs this package with no library).
 """
 from . import (abi, attitude, c_api, coarse_align, config, earth, fine_align, firmware, indexing, kalman,
                moving_align, strapdown)
