@@ -54,6 +54,18 @@ def _native():
     return native
 
 
+def config_check(fields):
+    """The firmware's check of a configuration dict (named like the C
+    fields): PYINS_OK (0) or the first negative PYINS_E_CONFIG_* status,
+    by the C core's pyins_config_check when the library is there, else by
+    the reference's mirror of it (the same status: test_xcheck_config).
+    ValueError for a field make_config refuses (unknown key, shape, type).
+    Its text is `pyins.contract.status_str`."""
+    if native is not None:
+        return native.lib.pyins_config_check(native.make_config(fields))
+    return reference.c_api.pyins_config_check(reference.c_api.make_config(fields))
+
+
 def firmware(engine, config):
     """A firmware instance of ``engine`` from a configuration dict."""
     if check(engine) == "native":

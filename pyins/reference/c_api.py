@@ -80,6 +80,12 @@ def pyins_status_str(status):
     return contract.status_str(status)
 
 
+def pyins_config_check(cfg):
+    """Mirrors pyins_config_check: PYINS_OK or the first PYINS_E_CONFIG_*
+    of a ``pyins_config *`` (either engine's FFI)."""
+    return config.config_check(config_from_struct(cfg))
+
+
 def pyins_init(raw):
     """(status, instance or None): check the whole configuration, then build."""
     status = config.config_check(raw)

@@ -169,3 +169,12 @@ def test_engine_choice_and_a_missing_native_engine(monkeypatch):
         engine.firmware("native", CFG)
     with pytest.raises(ImportError, match="not available"):
         engine.plant("native", None, None, None)
+
+
+@pytest.mark.parametrize("fields", [{}, CFG, dict(lat_rad=2.0), dict(tick_hz=-1), dict(fine_states=6),
+                                    dict(index_scheme=abi.PYINS_INDEX_CUSTOM), dict(seq_max_gap_ticks=101)])
+def test_config_check_is_the_cores_with_or_without_the_library(fields, monkeypatch):
+    want = native.lib.pyins_config_check(native.make_config(fields))
+    assert engine.config_check(fields) == want
+    monkeypatch.setattr(engine, "native", None)
+    assert engine.config_check(fields) == want
