@@ -35,7 +35,7 @@ void Firmware::init(const pyins_config& raw) {
     // stay 0 here: start_fine fits them to the coarse result
     // (fine_align::sigma0_after_coarse). The moving-base filter keeps its
     // default, already FIT's result with margin (config.hpp).
-    if (cfg.coarse_ticks > 0 && cfg.fine_states != 12) {
+    if (cfg.coarse_ticks > 0 && fine_filter::static_base(cfg.fine_states)) {
         for (int i = 0; i < 3; ++i) {
             if (raw.fine_sigma0_att_rad[i] == 0.0) {
                 cfg_.fine_sigma0_att_rad[i] = 0.0;
@@ -45,7 +45,7 @@ void Firmware::init(const pyins_config& raw) {
     dt_ = 1.0 / static_cast<double>(cfg.tick_hz);
     mode_ = Mode::kIdle;
     att_valid_ = cfg.coarse_ticks == 0;
-    kf_states_ = 0;
+    fine_.clear();
     fine_tick_ = 0;
     align_restarts_ = 0;
     gap_pending_ = false;
@@ -73,7 +73,6 @@ void Firmware::init(const pyins_config& raw) {
     lever_vel_n_ = Vec3::Zero();
     lever_refine_ = 0;
     integrity_lost_ = 0;
-    fine_vrw_ = 0.0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
     coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 
@@ -105,7 +104,7 @@ void Firmware::init(const pyins_config& raw) {
         prm.settle_from = cfg.coarse_ticks - cfg.coarse_ticks / 5;
         // the noise the static fine filters' R is built from, measured on
         // their update interval (coarse_align.hpp, "Noise")
-        const bool static_fine = cfg.fine_ticks > 0 && cfg.fine_states != 12;
+        const bool static_fine = cfg.fine_ticks > 0 && fine_filter::static_base(cfg.fine_states);
         prm.noise_every = static_fine && cfg.fine_noise == PYINS_FINE_NOISE_MEASURED
                               ? cfg.fine_meas_every_ticks : 0;
         coarse_align::init(coarse_, prm);
@@ -257,14 +256,35 @@ void Firmware::reference_point(double* lat, double* lon, double* height, Vec3* v
     *height = nav.height - d(2);
 }
 
-void Firmware::moving_fine(const Vec3& dtheta_p, const Vec3& dv_p) {
-    // The strapdown runs free in the horizontal (vertical held); every
-    // meas_every ticks the reference point's offset from the site is the
-    // measurement (moving_align.hpp), then attitude, velocity and position
-    // are corrected.
-    const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
+void Firmware::hold_static_base(Vec3* dv_sf_n) {
+    hold_at_site();
+    if (has_lever_ != 0) {
+        // The lever arm's share of the specific force in n over the tick,
+        // C_p^n (d/dt (C_p^i u^p)) = d/dt (C_p^n u^p) + w_ie^n x C_p^n u^p at
+        // rest: the difference of its velocity telescopes, so no angular
+        // acceleration is taken from the gyro.
+        double sin_lat;
+        double cos_lat;
+        pmath::sincos(cfg_.lat_rad, &sin_lat, &cos_lat);
+        const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
+        const Vec3 lv = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
+        *dv_sf_n = *dv_sf_n - (lv - lever_vel_n_) - attitude::cross(w_ie_n, lv) * dt_;
+        lever_vel_n_ = lv;
+    }
+}
+
+void Firmware::fine_tick(const Vec3& dtheta_p, const Vec3& dv_p) {
+    // The strapdown propagates the attitude. A static-base filter (seed 001)
+    // has position and velocity held at the site and measures the specific
+    // force in n; the moving-base one lets the horizontal channels run free
+    // (vertical held) and measures, every meas_every ticks, the reference
+    // point's offset from the site (moving_align.hpp).
+    Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
+    if (fine_.static_base()) {
+        hold_static_base(&dv_sf_n);
+    }
     double z[2] = {0.0, 0.0};
-    if (moving_align::measure(moving_)) {
+    if (fine_.measure()) {
         double lat = sd_.nav.lat;
         double lon = sd_.nav.lon;
         double height = sd_.nav.height;
@@ -272,20 +292,20 @@ void Firmware::moving_fine(const Vec3& dtheta_p, const Vec3& dv_p) {
         if (has_lever_ != 0) {
             reference_point(&lat, &lon, &height, &vel);
         }
-        z[0] = wrap_pi(lon - sd_.ref_lon) * moving_.prm.rn_h * moving_.prm.cos_lat;
-        z[1] = (lat - cfg_.lat_rad) * moving_.prm.rm_h;
+        fine_.site_offset(lat, lon, cfg_.lat_rad, sd_.ref_lon, z);
     }
-    const bool updated = moving_align::step(moving_, dv_sf_n, z);
-    if (!moving_.healthy) {
+    const bool updated = fine_.step(dv_sf_n, z);
+    if (!fine_.healthy()) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
     }
-    if (!moving_.consistent) {
+    if (!fine_.consistent()) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
         integrity_lost_ = 1;
     }
-    if (updated) {
-        // feedback in both correction modes: the free horizontal channels
-        // need their velocity and position corrected to stay linear
+    // The moving-base filter feeds back in both correction modes: its free
+    // horizontal channels need their velocity and position corrected to
+    // stay linear.
+    if (updated && (!fine_.static_base() || cfg_.fine_correction == PYINS_FINE_FEEDBACK)) {
         apply_fine_correction();
     }
     fine_tick_ = fine_tick_ + 1;
@@ -321,66 +341,37 @@ void Firmware::end_coarse() {
 }
 
 void Firmware::start_fine() {
-    fine_align::Params prm;
-    pmath::sincos(cfg_.lat_rad, &prm.sin_lat, &prm.cos_lat);
-    prm.gravity = earth::normal_gravity(prm.sin_lat, cfg_.height_m);
-    prm.dt = dt_;
-    prm.meas_every = cfg_.fine_meas_every_ticks;
-    prm.gyro_arw = cfg_.fine_gyro_arw;
-    prm.accel_vrw = cfg_.fine_accel_vrw;
-    prm.sigma0_att[0] = cfg_.fine_sigma0_att_rad[0];
-    prm.sigma0_att[1] = cfg_.fine_sigma0_att_rad[1];
-    prm.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
-    prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
-    prm.sigma0_accel = cfg_.fine_sigma0_accel;
-    if (cfg_.coarse_ticks > 0 && cfg_.fine_states != 12) {
-        // R from the noise the coarse phase measured when it is larger than
-        // the configured density (fine_noise MEASURED; coarse_align.hpp)
-        const double measured = coarse_align::measured_vrw(coarse_);
-        if (measured > prm.accel_vrw) {
-            prm.accel_vrw = measured;
-        }
-    }
-    fine_vrw_ = prm.accel_vrw;
+    fine_filter::Params prm;
+    fine_align::Params& base = prm.base;
+    pmath::sincos(cfg_.lat_rad, &base.sin_lat, &base.cos_lat);
+    base.gravity = earth::normal_gravity(base.sin_lat, cfg_.height_m);
+    base.dt = dt_;
+    base.meas_every = cfg_.fine_meas_every_ticks;
+    base.gyro_arw = cfg_.fine_gyro_arw;
+    base.accel_vrw = cfg_.fine_accel_vrw;
+    base.sigma0_att[0] = cfg_.fine_sigma0_att_rad[0];
+    base.sigma0_att[1] = cfg_.fine_sigma0_att_rad[1];
+    base.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
+    base.sigma0_gyro = cfg_.fine_sigma0_gyro;
+    base.sigma0_accel = cfg_.fine_sigma0_accel;
+    base.nis_window = cfg_.integrity_nis_window > 0 ? cfg_.integrity_nis_window : 0;
+    base.nis_max = cfg_.integrity_nis_max;
+    const earth::PrincipalRadii r = earth::principal_radii(base.sin_lat);
+    prm.rm_h = r.rm + cfg_.height_m;
+    prm.rn_h = r.rn + cfg_.height_m;
+    prm.pos_sigma = cfg_.fine_pos_sigma_m;
+    prm.sigma0_vel = cfg_.fine_sigma0_vel_mps;
+    // what the coarse phase measured (fine_filter.hpp says what each filter takes)
+    fine_filter::AfterCoarse after_coarse;
     if (cfg_.coarse_ticks > 0) {
-        // capped at the default (copied: the inline table's address is not taken)
-        const double cap[3] = {config::kDefaultFineSigmaAtt[0], config::kDefaultFineSigmaAtt[1],
-                               config::kDefaultFineSigmaAtt[2]};
-        fine_align::sigma0_after_coarse(prm, static_cast<double>(cfg_.coarse_ticks) * dt_, coarse_.wander, cap);
+        after_coarse.measured_vrw = coarse_align::measured_vrw(coarse_);
+        after_coarse.seconds = static_cast<double>(cfg_.coarse_ticks) * dt_;
+        after_coarse.wander = coarse_.wander;
     }
-    prm.nis_window = cfg_.integrity_nis_window > 0 ? cfg_.integrity_nis_window : 0;
-    prm.nis_max = cfg_.integrity_nis_max;
-    kf_states_ = cfg_.fine_states;
+    fine_.init(cfg_.fine_states, prm, cfg_.coarse_ticks > 0 ? &after_coarse : nullptr);
     fine_tick_ = 0;
-    if (kf_states_ == 12) {
-        moving_align::Params mp;
-        mp.sin_lat = prm.sin_lat;
-        mp.cos_lat = prm.cos_lat;
-        const earth::PrincipalRadii r = earth::principal_radii(prm.sin_lat);
-        mp.rm_h = r.rm + cfg_.height_m;
-        mp.rn_h = r.rn + cfg_.height_m;
-        mp.dt = dt_;
-        mp.meas_every = cfg_.fine_meas_every_ticks;
-        mp.gyro_arw = cfg_.fine_gyro_arw;
-        mp.accel_vrw = cfg_.fine_accel_vrw;
-        mp.pos_sigma = cfg_.fine_pos_sigma_m;
-        mp.sigma0_att[0] = cfg_.fine_sigma0_att_rad[0];
-        mp.sigma0_att[1] = cfg_.fine_sigma0_att_rad[1];
-        mp.sigma0_att[2] = cfg_.fine_sigma0_att_rad[2];
-        mp.sigma0_vel = cfg_.fine_sigma0_vel_mps;
-        mp.sigma0_gyro = cfg_.fine_sigma0_gyro;
-        mp.sigma0_accel = cfg_.fine_sigma0_accel;
-        mp.nis_window = prm.nis_window;
-        mp.nis_max = prm.nis_max;
-        moving_align::init(moving_, mp);
-    }
     if (has_lever_ != 0) {
         lever_vel_n_ = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
-    }
-    if (kf_states_ == 8) {
-        fine_align::init<8>(fine8_, prm);
-    } else if (kf_states_ == 5) {
-        fine_align::init<5>(fine5_, prm);
     }
     mode_ = Mode::kFineAlign;
 }
@@ -389,11 +380,7 @@ Vec3 Firmware::fine_phi() const {
     if (mode_ != Mode::kFineAlign) {
         return Vec3::Zero();
     }
-    if (kf_states_ == 12) {
-        return Vec3(moving_.x(moving_align::kPhi), moving_.x(moving_align::kPhi + 1),
-                    moving_.x(moving_align::kPhi + 2));
-    }
-    return kf_states_ == 8 ? fine_align::phi<8>(fine8_) : fine_align::phi<5>(fine5_);
+    return fine_.phi();
 }
 
 void Firmware::apply_fine_correction() {
@@ -408,28 +395,11 @@ void Firmware::apply_fine_correction() {
         // feedback loop that turns 1' of heading into 40 ug and diverges)
         lever_vel_n_ = attitude::quat_to_mat(q_phi) * lever_vel_n_;
     }
-    if (kf_states_ == 12) {
-        // velocity and position too (the moving-base filter's feedback)
-        const double* x = moving_.x.data();
-        double sin_lat;
-        double cos_lat;
-        pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
-        sd_.nav.vel_n(0) = sd_.nav.vel_n(0) - x[moving_align::kVel];
-        sd_.nav.vel_n(1) = sd_.nav.vel_n(1) - x[moving_align::kVel + 1];
-        sd_.nav.lat = sd_.nav.lat - x[moving_align::kPos + 1] / moving_.prm.rm_h;
-        sd_.nav.lon = wrap_pi(sd_.nav.lon - x[moving_align::kPos] / (moving_.prm.rn_h * cos_lat));
-        moving_align::reset_feedback(moving_);
-    } else if (kf_states_ == 8) {
-        fine_align::reset_phi<8>(fine8_);
-    } else {
-        fine_align::reset_phi<5>(fine5_);
-    }
+    fine_.feedback(sd_.nav);
 }
 
 bool Firmware::fine_heading_known() const {
-    const double var = kf_states_ == 12 ? moving_.p(2, 2)
-                       : (kf_states_ == 8 ? fine8_.p(2, 2) : fine5_.p(2, 2));
-    return var <= kValidHeadingSigma * kValidHeadingSigma;
+    return fine_.heading_variance() <= kValidHeadingSigma * kValidHeadingSigma;
 }
 
 void Firmware::end_fine() {
@@ -440,7 +410,7 @@ void Firmware::end_fine() {
         att_valid_ = false;
     }
     apply_fine_correction();
-    if (has_lever_ != 0 && kf_states_ != 12) {
+    if (has_lever_ != 0 && fine_.static_base()) {
         place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
     }
     start_navigation();
@@ -742,48 +712,8 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
         if (coarse_.tick == cfg_.coarse_ticks) {
             end_coarse();
         }
-    } else if (mode_ == Mode::kFineAlign && kf_states_ == 12) {
-        moving_fine(dtheta_p, dv_p);
     } else if (mode_ == Mode::kFineAlign) {
-        // Attitude by the strapdown; position and velocity held (static base).
-        Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p, dv_p, dt_);
-        hold_at_site();
-        if (has_lever_ != 0) {
-            // The lever arm's share of the specific force in n over the
-            // tick, C_p^n (d/dt (C_p^i u^p)) = d/dt (C_p^n u^p) + w_ie^n x
-            // C_p^n u^p at rest: the difference of its velocity telescopes,
-            // so no angular acceleration is taken from the gyro.
-            double sin_lat;
-            double cos_lat;
-            pmath::sincos(cfg_.lat_rad, &sin_lat, &cos_lat);
-            const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
-            const Vec3 lv = attitude::quat_to_mat(sd_.nav.quat_np) * lever_vel_p();
-            dv_sf_n = dv_sf_n - (lv - lever_vel_n_) - attitude::cross(w_ie_n, lv) * dt_;
-            lever_vel_n_ = lv;
-        }
-        bool updated;
-        bool healthy;
-        if (kf_states_ == 8) {
-            updated = fine_align::step<8>(fine8_, dv_sf_n);
-            healthy = fine8_.healthy;
-        } else {
-            updated = fine_align::step<5>(fine5_, dv_sf_n);
-            healthy = fine5_.healthy;
-        }
-        if (!healthy) {
-            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
-        }
-        if (!(kf_states_ == 8 ? fine8_.consistent : fine5_.consistent)) {
-            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
-            integrity_lost_ = 1;
-        }
-        if (updated && cfg_.fine_correction == PYINS_FINE_FEEDBACK) {
-            apply_fine_correction();
-        }
-        fine_tick_ = fine_tick_ + 1;
-        if (fine_tick_ == cfg_.fine_ticks) {
-            end_fine();
-        }
+        fine_tick(dtheta_p, dv_p);
     } else {
         strapdown::update(sd_, dtheta_p, dv_p, dt_);
         if (index_prm_.n_steps > 0) {
@@ -841,9 +771,7 @@ PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* heigh
         // provisional until the first NIS window has passed
         q_np = attitude::quat_renormalize(
             attitude::quat_mul(attitude::rotvec_to_quat(fine_phi()), nav.quat_np));
-        const int32_t windows = kf_states_ == 12 ? moving_.nis_windows
-                                : (kf_states_ == 8 ? fine8_.nis_windows : fine5_.nis_windows);
-        if ((cfg_.integrity_nis_window > 0 && windows == 0) || !fine_heading_known()) {
+        if ((cfg_.integrity_nis_window > 0 && fine_.nis_windows() == 0) || !fine_heading_known()) {
             valid = false;
         }
     }
@@ -907,36 +835,17 @@ void Firmware::output(pyins_output* out) const {
     out->n_seq_lost = counts_.seq_lost;
     out->n_encoder_jumps = counts_.encoder_jumps;
     out->seq = seq_;
-    out->align_nis = kf_states_ == 12 ? moving_.nis_mean
-                     : (kf_states_ == 8 ? fine8_.nis_mean : (kf_states_ == 5 ? fine5_.nis_mean : 0.0));
+    out->align_nis = fine_.nis_mean();
     out->coarse_wander_rad = cfg_.coarse_ticks > 0 ? coarse_.wander : 0.0;
     out->coarse_vrw = cfg_.coarse_ticks > 0 ? coarse_align::measured_vrw(coarse_) : 0.0;
-    out->fine_vrw = kf_states_ == 5 || kf_states_ == 8 ? fine_vrw_ : 0.0;
-    out->kf_states = kf_states_;
+    out->fine_vrw = fine_.vrw();
+    out->kf_states = fine_.states();
     out->align_restarts = align_restarts_;
     for (int i = 0; i < 8; ++i) {
         out->kf_x[i] = 0.0;
         out->kf_sigma[i] = 0.0;
     }
-    if (kf_states_ == 8) {
-        for (int i = 0; i < 8; ++i) {
-            out->kf_x[i] = fine8_.x(i);
-            out->kf_sigma[i] = pmath::sqrt(fine8_.p(i, i));
-        }
-    } else if (kf_states_ == 5) {
-        for (int i = 0; i < 5; ++i) {
-            out->kf_x[i] = fine5_.x(i);
-            out->kf_sigma[i] = pmath::sqrt(fine5_.p(i, i));
-        }
-    } else if (kf_states_ == 12) {
-        // [phi, eps, nabla_E, nabla_N]: the 8-state filter's layout
-        const int idx[8] = {0, 1, 2, moving_align::kEps, moving_align::kEps + 1, moving_align::kEps + 2,
-                            moving_align::kNabla, moving_align::kNabla + 1};
-        for (int i = 0; i < 8; ++i) {
-            out->kf_x[i] = moving_.x(idx[i]);
-            out->kf_sigma[i] = pmath::sqrt(moving_.p(idx[i], idx[i]));
-        }
-    }
+    fine_.record(out->kf_x, out->kf_sigma);
 }
 
 }  // namespace pyins::firmware

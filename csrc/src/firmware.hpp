@@ -11,9 +11,8 @@
 
 #include "pyins_core.h"
 #include "coarse_align.hpp"
-#include "fine_align.hpp"
+#include "fine_filter.hpp"
 #include "indexing.hpp"
-#include "moving_align.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 #include "units.hpp"
@@ -173,8 +172,12 @@ class Firmware {
     /// The reference point's position and velocity from the navigation
     /// state (the accelerometers') and the lever arm.
     void reference_point(double* lat, double* lon, double* height, Vec3* vel_n) const;
-    /// One tick of the moving-base fine alignment (fine_states = 12).
-    void moving_fine(const Vec3& dtheta_p, const Vec3& dv_p);
+    /// One tick of fine alignment (static or moving base).
+    void fine_tick(const Vec3& dtheta_p, const Vec3& dv_p);
+    /// A static-base fine-alignment tick's hold: position and velocity at
+    /// the site, and the lever arm's share taken out of the tick's specific
+    /// force in n, *dv_sf_n [m/s].
+    void hold_static_base(Vec3* dv_sf_n);
     /// Put the navigation state on the accelerometers of a reference point
     /// at (lat, lon, height) moving with vel_n, with the current attitude.
     void place_imu(double lat, double lon, double height, const Vec3& vel_n);
@@ -186,10 +189,7 @@ class Firmware {
     pyins_config cfg_;            ///< resolved configuration
     strapdown::Strapdown sd_;
     coarse_align::CoarseAlign coarse_;
-    fine_align::FineAlign<5> fine5_;
-    fine_align::FineAlign<8> fine8_;
-    moving_align::MovingAlign moving_;
-    int32_t kf_states_;           ///< 0 until fine alignment starts, then 5 or 8
+    fine_filter::FineFilter fine_;  ///< the fine-alignment filter (5, 8 or 12 states)
     int32_t fine_tick_;           ///< samples taken in fine alignment
     int32_t align_restarts_;      ///< alignments restarted after a rejected sample
     bool gap_pending_;            ///< a sample was rejected during alignment
@@ -218,7 +218,6 @@ class Firmware {
     int32_t lever_refine_;        ///< 1: navigation started from the configured state last tick
     int32_t integrity_lost_;      ///< 1: an integrity test failed: the attitude is never valid again
     double coarse_wander_max_;    ///< sine of integrity_coarse_rad
-    double fine_vrw_;             ///< accelerometer noise density of the static fine filter's R [(m/s)/sqrt(s)]
 };
 
 }  // namespace pyins::firmware
