@@ -13,12 +13,15 @@ behind a plain C ABI (``csrc/include/pyins_core.h``). This package holds:
 - ``pyins.units``: the unit constants and the tick, defined once;
 - ``pyins.scenario``: scenario files, checked and resolved to SI, and what a
   run of one is built from (its initial state included);
-- ``pyins.runner`` (open loop) and ``pyins.fil`` (the closed loop through
-  the turntable) run the firmware against the truth; ``pyins.runs`` runs a
-  scenario into a run directory and replays logs; ``pyins.records`` holds
-  the record files and checkpoints; ``pyins.metrics`` every metric;
-  ``pyins.campaign`` and ``pyins.report`` sets of runs and their reports;
-  ``pyins.logs`` IMU log files; ``pyins.analysis`` error models.
+- ``pyins.open_loop`` and ``pyins.fil`` (the closed loop through the
+  turntable) run the firmware against the truth; ``pyins.run_scenario``
+  runs a scenario into a run directory, ``pyins.rundir`` is that
+  directory (its layout, reading it back, the interrupt guard);
+  ``pyins.replay`` replays logs; ``pyins.records`` holds the record files
+  and checkpoints; ``pyins.metrics`` every metric; ``pyins.campaign`` and
+  ``pyins.report`` sets of runs and their reports; ``pyins.logs`` IMU log
+  files; ``pyins.analysis`` the error theory, ``pyins.budget`` the error
+  budget of a run.
 
 Conventions (shared by C++ and Python)
 --------------------------------------

@@ -26,9 +26,10 @@ import time
 
 import numpy as np
 
-from pyins import (__version__, bench, budget, campaign, engine, logs, metrics, native, replay, replay_options,
-                   report, runner, runs, scenario, sim, truth_track)
+from pyins import (__version__, bench, budget, campaign, engine, logs, metrics, native, open_loop, replay,
+                   replay_options, report, run_scenario, rundir, scenario, sim, truth_track)
 from pyins.progress import Phases, TextProgress, phase
+from pyins.report.paper import paper_rows
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M, TICK_HZ
 
 _TICKS_PER_HOUR = 3600 * TICK_HZ
@@ -49,7 +50,7 @@ def _demo(args):
             print(f"\r  {done / _TICKS_PER_HOUR:6.2f} h of {total / _TICKS_PER_HOUR:.2f} h ship time", end="",
                   flush=True)
 
-    result = runner.navigate(motion, ticks, every=100, sensors=sensors, progress=progress)
+    result = open_loop.navigate(motion, ticks, every=100, sensors=sensors, progress=progress)
     wall = time.perf_counter() - t0
     if not args.quiet and sys.stdout.isatty():
         print()
@@ -145,7 +146,7 @@ def _summary_lines(summary):
                    f"final level {m['level_error_final'] / ARCSEC_TO_RAD:.2f}\", "
                    f"final heading {m['heading_error_final'] / ARCMIN_TO_RAD:.3f}'"
                    + ("" if v["complete"] else f"  [partial: {v['ticks_done']} of {v['ticks']} ticks]"))
-    for r in runs.paper_rows(summary):
+    for r in paper_rows(summary):
         ours = "-" if r["ours"] is None else f"{r['ours']:.4g}"
         out.append(f"  paper {r['metric']} [{r['variant']}]: {r['relation']} {r['paper']:g} {r['unit']}"
                    f"; ours {ours} {r['unit']} {r['verdict']}")
@@ -179,7 +180,7 @@ def cmd_run(args):
     out = args.out or _default_out(scn.name)
     _say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
     try:
-        summary = runs.execute(scn, out, progress=_progress(args), resume=args.resume,
+        summary = run_scenario.execute(scn, out, progress=_progress(args), resume=args.resume,
                                log=None if args.quiet or args.json else print, engine=args.engine,
                                force=getattr(args, "force", False),
                                notice=lambda text: print(f"pyins run: note: {text}", file=sys.stderr))
@@ -332,7 +333,7 @@ def cmd_report(args):
         _say(args, f"report: {path}")
         _emit_json(args, dict(report=path, complete=True))
         return EXIT_OK
-    if runs.read_summary(args.rundir) is None:
+    if rundir.read_summary(args.rundir) is None:
         what = ("the run stopped before it wrote its summary" if os.path.exists(
             os.path.join(args.rundir, "resolved_scenario.json")) else "not a run directory")
         raise InputError(f"{args.rundir}: {what} (no readable summary.json)")

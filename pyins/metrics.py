@@ -90,7 +90,7 @@ def position_errors(lat_rad, lon_rad, lat_t, lon_t, height_t):
 def nav_errors(result):
     """Position, velocity and attitude errors of a result with ``outputs``
     (firmware records), ``truth`` (pyins.sim.Truth at the same ticks) and
-    ``dt`` (a runner.RunResult or a records.FilResult)."""
+    ``dt`` (an open_loop.RunResult or a records.FilResult)."""
     out, tr = result.outputs, result.truth
     north, east = position_errors(out["lat_rad"], out["lon_rad"], tr.lat, tr.lon, tr.height)
     # q_err = q_nb(computed) (x) conj(q_nb(true)) = rotation by -phi in n: the

@@ -7,7 +7,7 @@ A record directory (``fil.run_fil(record_dir=...)``) holds::
     records.json      what the two files hold: dtypes, interval, ticks done
     checkpoint.json   the last checkpoint (firmware, plant, noise generator)
 
-A variant directory of a run (``pyins.runs``) adds ``timeseries.npz`` and
+A variant directory of a run (``pyins.rundir``) adds ``timeseries.npz`` and
 ``timeseries.csv``: the records beside their errors against the truth.
 
 Every file that a kill may interrupt is written through a temporary file

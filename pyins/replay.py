@@ -29,13 +29,13 @@ import os
 import numpy as np
 
 from pyins import engine as engines
-from pyins import logs, metrics, native, records, runner, scenario, sim
+from pyins import logs, metrics, native, open_loop, records, scenario, sim
 from pyins.reference import abi
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
 from pyins.truth_track import TruthTrack
-from pyins.runs import hold_interrupts
+from pyins.rundir import hold_interrupts
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, TICK_HZ
 
 __all__ = ["replay", "replay_config", "warnings", "REFERENCES"]
@@ -90,7 +90,7 @@ def _parked_errors(recs, cfg, hz):
     (its attitude errors mean nothing here and are not kept)."""
     site = sim.Static(cfg["lat_rad"], cfg["lon_rad"], cfg.get("height_m", 0.0))
     dt = 1.0 / hz
-    e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=sim.truth_at(site, recs["tick"], dt=dt), dt=dt))
+    e = metrics.nav_errors(open_loop.RunResult(outputs=recs, truth=sim.truth_at(site, recs["tick"], dt=dt), dt=dt))
     return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
 
 
@@ -124,7 +124,7 @@ class _Summary:
             self.last_fine = recs[fine[-1]:fine[-1] + 1].copy()
         if self.spec is not None:
             truth = sim.truth_at(self.spec.motion, recs["tick"], dt=self.spec.dt)
-            e = metrics.nav_errors(runner.RunResult(outputs=recs, truth=truth, dt=self.spec.dt))
+            e = metrics.nav_errors(open_loop.RunResult(outputs=recs, truth=truth, dt=self.spec.dt))
             err = dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
             self.horizontal_max = max(self.horizontal_max, float(e.horizontal_m.max()))
             self.level_max = max(self.level_max, float(np.abs(e.att_n_rad[:, :2]).max()))

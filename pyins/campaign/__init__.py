@@ -7,7 +7,7 @@ overrides applied to every run, noise seeds (a count or a list, optionally
 turned into the scenario's ``seed`` by a formula) and the keys to group the
 runs by. Every combination of grid values times every seed is one *point*;
 each point is one scenario, validated when the campaign is built, and run
-with `pyins.runs.execute` into ``OUT/runs/<digest[:16]>`` where ``digest``
+with `pyins.run_scenario.execute` into ``OUT/runs/<digest[:16]>`` where ``digest``
 is `Scenario.digest` of the overridden scenario: runs are content
 addressed, so a campaign that is run again (after a kill, a Ctrl-C, or with
 more seeds) runs only what has no complete summary.json of that digest.

@@ -1,6 +1,6 @@
 """Running a campaign: its missing runs, on a local process pool or a Dask cluster.
 
-Runs are content addressed: point ``p`` runs with `pyins.runs.execute` into
+Runs are content addressed: point ``p`` runs with `pyins.run_scenario.execute` into
 ``OUT/<p.dir>`` = ``OUT/runs/<digest[:16]>``, so a campaign that is run
 again (after a kill, a Ctrl-C, or with more seeds) runs only what has no
 complete summary.json of that digest (`pending`). Each run writes only its
@@ -40,7 +40,7 @@ import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from pyins import records, runs
+from pyins import records, run_scenario, rundir
 from pyins import scenario as scenario_mod
 from pyins.campaign.aggregate import aggregate, plan, read_summary, write_json
 
@@ -79,7 +79,7 @@ def _is_done(run_dir, digest):
 def _run_point(task):
     """Run one point into its run directory (in a pool process or on a Dask
     worker): rebuild the scenario from the base's data and the overrides,
-    check its digest, `pyins.runs.execute` it (resume=True: an earlier
+    check its digest, `pyins.run_scenario.execute` it (resume=True: an earlier
     killed attempt continues from its checkpoint). Returns
     {"digest", "wall_s", "summary"}."""
     t0 = time.perf_counter()
@@ -92,7 +92,7 @@ def _run_point(task):
                             f"every worker")
     run_dir = task["run_dir"]
     point_json = os.path.join(run_dir, "point.json")
-    with runs.hold_interrupts(defer=True):      # point.json whole or not at all
+    with rundir.hold_interrupts(defer=True):      # point.json whole or not at all
         os.makedirs(run_dir, exist_ok=True)
         if os.path.exists(point_json):
             with open(point_json) as f:
@@ -104,11 +104,11 @@ def _run_point(task):
                                     "overrides": task["overrides"]})
     notices = []           # a stale lock taken over (a killed earlier attempt), told by run_campaign
     try:
-        summary = runs.execute(scn, run_dir, resume=True, notice=notices.append)
+        summary = run_scenario.execute(scn, run_dir, resume=True, notice=notices.append)
     except ValueError as exc:
         if "checkpoint belongs to another run" not in str(exc):
             raise
-        summary = runs.execute(scn, run_dir, resume=False)   # a checkpoint of an older pyins
+        summary = run_scenario.execute(scn, run_dir, resume=False)   # a checkpoint of an older pyins
     return {"digest": digest, "wall_s": time.perf_counter() - t0, "summary": summary, "notices": notices}
 
 
@@ -190,7 +190,7 @@ def _run_local(tasks, workers, on_done, on_stopped):
                 # `running` and not yet told would be finished on disk and
                 # missing from the counts: the user's Ctrl-C tends to come
                 # just as a run ends)
-                with runs.hold_interrupts(defer=True):
+                with rundir.hold_interrupts(defer=True):
                     t = running.pop(f)
                     exc = f.exception()
                     if isinstance(exc, KeyboardInterrupt):   # the terminal's Ctrl-C reached the worker first
@@ -201,7 +201,7 @@ def _run_local(tasks, workers, on_done, on_stopped):
                     if nxt is not None:
                         running[ex.submit(_pool_point, nxt)] = nxt
     except KeyboardInterrupt:
-        with runs.hold_interrupts():
+        with rundir.hold_interrupts():
             _stop_pool(ex, running, on_done, on_stopped)
         raise
     except BaseException:
@@ -263,7 +263,7 @@ def _run_dask(tasks, scheduler, on_done, on_stopped):
         told = set()
         try:
             for f in distributed.as_completed(futs):
-                with runs.hold_interrupts(defer=True):   # told whole, as in _run_local
+                with rundir.hold_interrupts(defer=True):   # told whole, as in _run_local
                     if f.status == "error":
                         on_done(index[f.key], None, f.exception())
                     else:
@@ -364,7 +364,7 @@ def _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notic
         interrupted = True
         how = "interrupted (Ctrl-C)"
     # 3. the aggregates (of what finished, without plots, after a Ctrl-C)
-    with runs.hold_interrupts():
+    with rundir.hold_interrupts():
         result = aggregate(camp, out_dir, plots=plots and not interrupted)
         ended = state["computed"] + len(state["failed"]) + len(state["interrupted"])
         result["execution"] = {"scheduler": how, "runs": total, "computed": state["computed"],

@@ -1,6 +1,6 @@
 """A run's page and figures: the plots and report.html of a run directory (``pyins report RUNDIR``).
 
-Reads only what `pyins.runs.execute` wrote (summary.json, the variants'
+Reads only what `pyins.run_scenario.execute` wrote (summary.json, the variants'
 timeseries.npz), so a report can be re-rendered, or rendered for a partial
 run, without running anything. Units follow the papers (`pyins.metrics`):
 position errors in m or nmi (whichever reads better), level errors in
@@ -22,7 +22,7 @@ latitude is 1 nmi).
    `VARIANTS_PER_TABLE` a table: the page reads at 1200 px whatever the
    number of metrics), the position error split north/east and
    latitude/longitude, the group metrics, the paper's figures beside ours
-   (`pyins.runs.paper_rows`: a stopped run, or one run for another length
+   (`pyins.report.paper.paper_rows`: a stopped run, or one run for another length
    than the scenario gives it, is labelled and not judged);
 3. report.html, with the scenario as run.
 
@@ -35,10 +35,11 @@ import os
 
 import numpy as np
 
-from pyins import metrics, records, runs
+from pyins import metrics, records, rundir
 from pyins.metrics import FIGURE_METRICS, display
 from pyins.progress import phase
 from pyins.reference import abi, earth
+from pyins.report.paper import not_judged, paper_rows, span
 from pyins.report.plotting import cycle_window, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
 
@@ -52,14 +53,14 @@ _DPI = 90
 
 def _fill_facts(run_dir, summary, scn):
     """Duration as run and as written, and the use of the flexible sums, for
-    the variants of a summary written before `pyins.runs` recorded them."""
+    the variants of a summary written before `pyins.run_scenario` recorded them."""
     if all("duration_s" in v and "uses_index_sums" in v for v in summary["variants"]):
         return
-    scn = scn if scn is not None else runs.scenario_of(run_dir, summary)
+    scn = scn if scn is not None else rundir.scenario_of(run_dir, summary)
     if scn is None:
         return
-    written = runs.written_durations(scn)
-    facts = {spec.label: runs.variant_facts(spec, written) for spec in scn.runs()}
+    written = rundir.written_durations(scn)
+    facts = {spec.label: rundir.variant_facts(spec, written) for spec in scn.runs()}
     for v in summary["variants"]:
         for k, val in facts.get(v["label"], {}).items():
             v.setdefault(k, val)
@@ -71,11 +72,11 @@ def load(run_dir):
     variant's records on disk beside the truth of the scenario the run was
     written from, its metrics computed here (summary.json is left as it is);
     ``summary["stopped"]`` says how it stands."""
-    summary = runs.read_summary(run_dir)
+    summary = rundir.read_summary(run_dir)
     if summary is None:
-        raise FileNotFoundError(f"{run_dir}: not a run directory (no readable {runs.SUMMARY})")
+        raise FileNotFoundError(f"{run_dir}: not a run directory (no readable {rundir.SUMMARY})")
     unfinished = [v for v in summary["variants"] if not v.get("complete")]
-    scn = runs.scenario_of(run_dir, summary) if unfinished else None
+    scn = rundir.scenario_of(run_dir, summary) if unfinished else None
     specs = {spec.label: spec for spec in scn.runs()} if scn is not None else {}
     _fill_facts(run_dir, summary, scn)
     series = {}
@@ -83,7 +84,7 @@ def load(run_dir):
         path = os.path.join(run_dir, v["dir"], "timeseries.npz")
         spec = specs.get(v["label"])
         if not v.get("complete") and spec is not None:
-            res = runs.load_written(run_dir, spec)
+            res = rundir.load_written(run_dir, spec)
             if res is not None:
                 series[v["label"]] = records.timeseries(res)
                 v["ticks_done"] = int(res.outputs["tick"][-1])
@@ -133,9 +134,9 @@ def _clock(series):
     """(seconds per unit, axis label) of one time axis for every variant of a
     figure: the unit `time_axis` picks for the longest of them (a stopped
     variant is drawn on the same axis as the finished ones)."""
-    span = max((float(s["time_s"][-1]) for s in series.values() if len(s["time_s"])), default=0.0)
-    shown, label = time_axis(np.array([span]))
-    return (span / shown[0] if span > 0 else 1.0), label
+    longest = max((float(s["time_s"][-1]) for s in series.values() if len(s["time_s"])), default=0.0)
+    shown, label = time_axis(np.array([longest]))
+    return (longest / shown[0] if longest > 0 else 1.0), label
 
 
 def _colours(summary):
@@ -317,7 +318,7 @@ def plot_comparison(summary, path):
         if f["metric"].startswith("horizontal_error") and f.get("variant"):
             paper[f["variant"]] = f["value_si"] / sc
     if paper:
-        caveat = runs.not_judged([v for v in vs if v["label"] in paper])
+        caveat = not_judged([v for v in vs if v["label"] in paper])
         ax.bar(x + 0.25, [paper.get(v["label"], 0.0) for v in vs], 0.25,
                label="paper" + (" (for the full-length run: not comparable)" if caveat else ""))
     ax.set_xticks(x, [v["label"] for v in vs], fontsize=8, rotation=10)
@@ -342,13 +343,13 @@ def _ours(row):
 def _status(v):
     dur = v.get("duration_s")
     if not v.get("complete"):
-        done = (f"{runs.span(dur * v.get('ticks_done', 0) / v['ticks'])} of {runs.span(dur)}"
+        done = (f"{span(dur * v.get('ticks_done', 0) / v['ticks'])} of {span(dur)}"
                 if dur and v.get("ticks") else f"{v.get('ticks_done', 0)} of {v['ticks']} ticks")
         return f"partial: {done}"
     written = v.get("written_duration_s")
-    if dur is not None and written is not None and runs.not_judged([v]):
-        return f"{runs.span(dur)} (the scenario: {runs.span(written)})"
-    return f"complete, {runs.span(dur)}" if dur else "complete"
+    if dur is not None and written is not None and not_judged([v]):
+        return f"{span(dur)} (the scenario: {span(written)})"
+    return f"complete, {span(dur)}" if dur else "complete"
 
 
 def _component_rows(summary, series):
@@ -408,11 +409,11 @@ def _caveats(summary):
     if not summary["complete"]:
         out.append(f"PARTIAL ({summary.get('stopped', 'interrupted')}): the figures and tables cover the "
                    "ticks done; the paper's figures are not judged on a stopped variant.")
-    retimed = [v for v in summary["variants"] if v.get("complete") and runs.not_judged([v])]
+    retimed = [v for v in summary["variants"] if v.get("complete") and not_judged([v])]
     if retimed:
         v = retimed[0]
-        out.append(f"Run for {runs.span(v['duration_s'])}; the scenario as written runs "
-                   f"{runs.span(v['written_duration_s'])}, the length its paper's figures are for: they are "
+        out.append(f"Run for {span(v['duration_s'])}; the scenario as written runs "
+                   f"{span(v['written_duration_s'])}, the length its paper's figures are for: they are "
                    "shown beside ours and not judged.")
     return out
 
@@ -426,7 +427,7 @@ def _paper_html(summary):
         f"<td>{esc(r['relation'])} {r['paper']:g} {esc(r['unit'])}</td>"
         f"<td>{esc(_ours(r))}</td><td class='{'verdict' if r['judged'] else 'unjudged'}'>{esc(r['verdict'])}</td>"
         f"<td class='note'>{esc(r['note'])}</td></tr>"
-        for r in runs.paper_rows(summary))
+        for r in paper_rows(summary))
     cols = "".join(f"<col style='width: {w}%'>" for w in (15, 13, 9, 10, 15, 38))
     return (f"<h2>Beside the paper</h2><p>{esc(paper.get('citation', ''))}</p>"
             f"<p class='note'>{esc(paper.get('note', ''))}</p>"

@@ -25,7 +25,7 @@ the built-ins.
 
     >>> sc = load("seed002_exp1")            # a built-in, or a path to a .toml file
     >>> for run in sc.runs():                 # one RunSpec per [compare] value
-    ...     result = runs.run(run)            # pyins.runs.run: fil.run_fil(...)  # doctest: +SKIP
+    ...     result = run_scenario.run(run)    # pyins.run_scenario.run: fil.run_fil(...)  # doctest: +SKIP
 
 The built-in scenarios are TOML files in ``pyins/scenarios/`` (shipped in
 the wheel: scikit-build-core's ``wheel.packages = ["pyins"]`` copies every

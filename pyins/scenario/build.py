@@ -2,7 +2,7 @@
 sensor errors, the turntable, the firmware's configuration, and the initial
 state handed to the firmware (the truth at t = 0, plus the file's initial
 errors), each built once here; `RunSpec` holds them for one run
-(`pyins.runs.run` runs it).
+(`pyins.run_scenario.run` runs it).
 
 The firmware's own check of a configuration (``pyins_config_check``) runs
 at load time (`_firmware_check`), so a refused value names its key.
@@ -278,7 +278,7 @@ def _firmware_check(motion, cfg):
 @dataclass
 class RunSpec:
     """One run of a scenario: everything ``pyins.fil.run_fil`` needs
-    (`pyins.runs.run` runs it)."""
+    (`pyins.run_scenario.run` runs it)."""
     label: str                    #: the [compare] label (the scenario name without [compare])
     index: int                    #: position among the scenario's runs
     scenario: str                 #: the scenario's name

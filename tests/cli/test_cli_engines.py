@@ -1,13 +1,13 @@
 """The engine choice end to end: a built-in scenario, shortened to 30 s of
 ship time, through ``pyins run --engine native`` and ``--engine reference``
-(the same code path: pyins.runs.execute -> pyins.fil.run_fil, with the
+(the same code path: pyins.run_scenario.execute -> pyins.fil.run_fil, with the
 compiled firmware and plant or their NumPy mirrors), and a log through
 ``pyins replay --engine``."""
 import numpy as np
 import pytest
 
 from pyins import __main__ as cli
-from pyins import records, runs, scenario
+from pyins import records, rundir, scenario
 
 #: seed 002's flexible scheme with a 5 s stop: the table turns within 30 s,
 #: so the firmware's motor commands close the loop through the plant.
@@ -21,7 +21,7 @@ def _records(run_dir, engine):
     scn = scenario.load("seed002_exp1")
     got = {}
     for spec in scn.runs():
-        outputs, plant, info = records.load_records(str(out / runs.slug(spec.label) / "records"))
+        outputs, plant, info = records.load_records(str(out / rundir.slug(spec.label) / "records"))
         assert info["complete"] and len(outputs) == 60
         got[spec.label] = (np.array(outputs), np.array(plant))
     return got

@@ -17,7 +17,7 @@ import time
 import pytest
 
 from pyins import __main__ as cli
-from pyins import runs, scenario
+from pyins import rundir, scenario
 from pyins.records import PLANT_RECORD_DTYPE
 
 #: How long after SIGINT a command may take to exit. The brief is "a second
@@ -292,12 +292,12 @@ def test_a_run_killed_as_it_began_is_started_again_and_a_users_file_is_kept(tmp_
     d = tmp_path / "run"
     d.mkdir()
     (d / "scenario.toml").write_text(scn.text)
-    assert runs.check_run_dir(scn, str(d)) == "new"
+    assert rundir.check_run_dir(scn, str(d)) == "new"
     (d / "scenario.toml").write_text("# my own notes\n")
-    with pytest.raises(runs.RunDirError, match="not a pyins run directory"):
-        runs.check_run_dir(scn, str(d))
+    with pytest.raises(rundir.RunDirError, match="not a pyins run directory"):
+        rundir.check_run_dir(scn, str(d))
     assert (d / "scenario.toml").read_text() == "# my own notes\n"
     # the resolved scenario alone names the run: a resume recognises it
     (d / "scenario.toml").unlink()
     (d / "resolved_scenario.json").write_text(scn.resolved_json())
-    assert runs.check_run_dir(scn, str(d)) == "same"
+    assert rundir.check_run_dir(scn, str(d)) == "same"

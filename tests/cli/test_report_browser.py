@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from pyins import report, runs, scenario
+from pyins import report, run_scenario, scenario
 
 CHECK = """
 <script>
@@ -33,7 +33,7 @@ def test_report_renders_in_headless_chromium(tmp_path):
     browser = _browser()
     scn = scenario.load("seed003").with_overrides({"duration": "0.2 h"})
     out = tmp_path / "run"
-    runs.execute(scn, str(out))
+    run_scenario.execute(scn, str(out))
     page = report.render(str(out))
     text = open(page).read()
     assert "<script" not in text

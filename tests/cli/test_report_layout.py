@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 from pyins import __main__ as cli
-from pyins import report, runs, scenario
+from pyins import report, run_scenario, rundir, scenario
+from pyins.report.paper import paper_rows
 from pyins.progress import Phases
 from pyins.report import plotting
 from pyins.report import run as run_report
@@ -107,7 +108,7 @@ def _run(tmp_path, text, name="run", overrides=None):
     if overrides:
         scn = scn.with_overrides(overrides)
     out = tmp_path / name
-    runs.execute(scn, str(out))
+    run_scenario.execute(scn, str(out))
     return out
 
 
@@ -133,7 +134,7 @@ def test_a_full_run_is_judged_and_a_stopped_one_is_labelled_not_judged(tmp_path)
         return progress
     out = tmp_path / "stopped"
     with pytest.raises(KeyboardInterrupt):
-        runs.execute(scenario.loads(BOUND), str(out), progress=stop_after_the_first_chunk)
+        run_scenario.execute(scenario.loads(BOUND), str(out), progress=stop_after_the_first_chunk)
     page = open(report.render(str(out))).read()
     (variant, ours, verdict), = _paper_cells(page)
     assert ours.endswith(" nmi")                   # our figure is shown ...
@@ -156,8 +157,8 @@ def test_a_shortened_run_is_labelled_and_not_judged_against_the_full_length_figu
     assert verdict.startswith("not judged: run shortened")
     assert "Run for 30 min; the scenario as written runs 1 h" in html.unescape(page)
     # --seed changes no length: judged as before
-    summary = runs.read_summary(str(_run(tmp_path, BOUND, "seeded", {"seed": 7})))
-    assert [r["verdict"] for r in runs.paper_rows(summary)] == ["within"]
+    summary = rundir.read_summary(str(_run(tmp_path, BOUND, "seeded", {"seed": 7})))
+    assert [r["verdict"] for r in paper_rows(summary)] == ["within"]
 
 
 # ---------------------------------------------------------------------------
@@ -212,7 +213,7 @@ def test_an_alignment_only_run_has_no_position_panels(tmp_path, drawn):
     velocity panels would be flat lines at zero."""
     scn = scenario.load("seed001_fine5").with_overrides({"duration": "120 s", "firmware.fine_time": "120 s"})
     out = tmp_path / "fine"
-    runs.execute(scn, str(out))
+    run_scenario.execute(scn, str(out))
     page = html.unescape(open(report.render(str(out))).read())
     ylabels = [a["ylabel"] for a in drawn["errors.png"]]
     assert len(ylabels) == 2 and "level" in ylabels[0] and "heading" in ylabels[1]

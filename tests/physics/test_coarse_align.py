@@ -7,7 +7,7 @@ must sit near the theoretical limit (the part no alignment can observe).
 import numpy as np
 import pytest
 
-from pyins import metrics, runner, scenario, sim
+from pyins import metrics, open_loop, scenario, sim
 from pyins.reference import abi, attitude, earth
 from pyins import units
 
@@ -28,7 +28,7 @@ def motion(state, heading_deg):
 def align(m, seconds, sensors=None, ratio=0.5, method=0):
     n = int(seconds * 100)
     # the configured attitude is a deliberately wrong guess: alignment must find it
-    res = runner.navigate(m, n, every=100, sensors=sensors,
+    res = open_loop.navigate(m, n, every=100, sensors=sensors,
                           config=dict(coarse_ticks=n, coarse_ratio=ratio, euler_b_rad=[0.0, 0.0, 0.0],
                                       coarse_method=method))
     return res, metrics.nav_errors(res)

@@ -7,7 +7,7 @@ prints its figures (pytest -s) so regressions are visible before they fail.
 import numpy as np
 import pytest
 
-from pyins import metrics, runner, sim
+from pyins import metrics, open_loop, sim
 from pyins import units
 
 DEG = units.DEG_TO_RAD
@@ -27,7 +27,7 @@ def test_static_24h():
     inconsistency between plant and firmware (Earth model, gravity, frames)
     would show as a Schuler/24 h oscillation of metres."""
     motion = sim.Static(*XIAN, 380.0, pitch=1 * DEG, roll=-2 * DEG, yaw=-15 * DEG)
-    e = metrics.nav_errors(runner.navigate(motion, 24 * 360_000, every=100))
+    e = metrics.nav_errors(open_loop.navigate(motion, 24 * 360_000, every=100))
     _report("static 24 h", e)
     assert e.horizontal_m.max() < 0.1
     assert np.abs(e.att_n_rad).max() < 0.01 * ARCSEC
@@ -40,7 +40,7 @@ def test_bad_sea_swing_1h(yaw_deg):
     fails this (17 m: a rectified 6e-5 deg/h drift and ~1 ug), which is why
     the core uses three samples and the second-order rotation term."""
     motion = sim.sea_state("bad", *XIAN, 0.0, yaw0=yaw_deg * DEG)
-    e = metrics.nav_errors(runner.navigate(motion, 360_000, every=100))
+    e = metrics.nav_errors(open_loop.navigate(motion, 360_000, every=100))
     _report(f"bad sea 1 h, yaw {yaw_deg}", e)
     assert e.horizontal_m.max() < 1.0
     # attitude: the same 0.01 arcsec as static; a coning drift shows here first
@@ -50,7 +50,7 @@ def test_bad_sea_swing_1h(yaw_deg):
 def test_manoeuvre_30min():
     """Accelerate to 10 m/s, two turns, decelerate, 30 min: < 1 m."""
     motion = sim.Manoeuvre.default(*XIAN, 0.0, yaw0=0.3)
-    e = metrics.nav_errors(runner.navigate(motion, 180_000, every=100))
+    e = metrics.nav_errors(open_loop.navigate(motion, 180_000, every=100))
     _report("manoeuvre 30 min", e)
     assert e.horizontal_m.max() < 1.0
     assert np.abs(e.vel_n_mps).max() < 1e-3     # m/s; 1 m in 30 min needs ~1e-3 m/s

@@ -61,13 +61,13 @@ def test_drift_surviving_at_the_full_rate_equals_every_tick(label):
     tick-sampled mean is itself a rectangle rule on 0.01 s steps of a 6 deg/s
     turn (measured 1e-5 at 1 h and 6 h; 1 Hz records differ from every tick
     by up to 2.7e-4 at 1 h: the test fails on a sampled proxy)."""
-    from pyins import runs, scenario
+    from pyins import run_scenario, scenario
     sc = scenario.load("seed002_exp2")
     got = {}
     for every in ("1 s", "0.01 s"):
         spec = next(s for s in sc.with_overrides({"duration": "1 h", "record_every": every}).runs()
                     if s.label == label)
-        got[every] = (spec, runs.run(spec))
+        got[every] = (spec, run_scenario.run(spec))
     spec, res = got["1 s"]
     cont = analysis.drift_surviving_of_run(spec.motion, res, spec.config)
     out = got["0.01 s"][1].outputs

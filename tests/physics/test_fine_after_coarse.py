@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from pyins import __main__ as cli
-from pyins import analysis, metrics, runner, sim, units
+from pyins import analysis, metrics, open_loop, sim, units
 from pyins.reference import abi, config, earth, fine_align
 from pyins.units import UG_TO_MPS2 as UG
 
@@ -30,7 +30,7 @@ LOG = os.path.join(os.path.dirname(__file__), os.pardir, "data", "lasergyro_300s
 def coarse_then_fine(states, seed, fine_ticks, method=1, every=10, **cfg):
     m = sim.Static(LAT, 108.91 * DEG, 0.0, *EULER)
     errors = sim.preset("seed001")
-    res = runner.navigate(m, COARSE + fine_ticks, every=every, sensors=sim.SensorModel(errors, seed=seed),
+    res = open_loop.navigate(m, COARSE + fine_ticks, every=every, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(coarse_ticks=COARSE, coarse_method=method, fine_ticks=fine_ticks,
                                       fine_states=states, **cfg))
     out = res.outputs
@@ -118,7 +118,7 @@ def test_the_start_fits_the_coarse_result_and_a_configured_sigma_is_kept():
     np.testing.assert_allclose(out["kf_sigma"][start][:3] / ARCMIN, [1.0, 1.0, 10.0], rtol=1e-12)
 
     m = sim.Static(LAT, 108.91 * DEG, 0.0, *EULER)
-    res = runner.navigate(m, 10, every=1, config=dict(fine_ticks=10, fine_states=5))
+    res = open_loop.navigate(m, 10, every=1, config=dict(fine_ticks=10, fine_states=5))
     # one tick's prediction: P grows by arw^2 dt, 1e-15 of P0
     np.testing.assert_allclose(res.outputs["kf_sigma"][0][:3], OLD_DEFAULT, rtol=1e-9)
 

@@ -10,7 +10,7 @@ gives no latitude: we use 34.246 N (Xi'an, where its authors work; also seed
 import numpy as np
 import pytest
 
-from pyins import analysis, metrics, runner, sim
+from pyins import analysis, metrics, open_loop, sim
 from pyins.reference import attitude, earth
 from pyins import units
 
@@ -26,7 +26,7 @@ def run_seed001(states, seed, errors=None, phi0=np.array([10.0, 10.0, 60.0]) * A
     m = sim.Static(LAT, 108.91 * DEG, 0.0, *EULER)
     guess = attitude.mat_to_euler(attitude.rotvec_to_mat(-phi0) @ attitude.euler_to_mat(EULER))
     errors = errors if errors is not None else sim.preset("seed001")
-    res = runner.navigate(m, N, every=1000, sensors=sim.SensorModel(errors, seed=seed),
+    res = open_loop.navigate(m, N, every=1000, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(euler_b_rad=guess, fine_ticks=N, fine_states=states, **cfg))
     return res, metrics.nav_errors(res), analysis.alignment_limits(LAT, EULER, errors.gyro_bias,
                                                                   errors.accel_bias)

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from pyins import metrics, runner, sim
+from pyins import metrics, open_loop, sim
 from pyins.reference import abi, config
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
@@ -29,7 +29,7 @@ SITES = {"static": lambda: sim.Static(LAT, LON, 0.0, 0.0, 0.0, 0.7),
 
 def _run(motion, vrw_ug, seed=0, fine_ticks=100, every=100, fine_states=5, **cfg):
     errors = replace(sim.preset("seed001"), accel_vrw=vrw_ug * UG)
-    res = runner.navigate(motion, COARSE + fine_ticks, every=every, sensors=sim.SensorModel(errors, seed=seed),
+    res = open_loop.navigate(motion, COARSE + fine_ticks, every=every, sensors=sim.SensorModel(errors, seed=seed),
                           config=dict(coarse_ticks=COARSE, coarse_method=abi.PYINS_COARSE_FIT,
                                       fine_ticks=fine_ticks, fine_states=fine_states, **cfg))
     return res.outputs
@@ -106,7 +106,7 @@ def test_the_heading_sigma_tells_the_truth_on_a_noisy_site():
     motion = SITES["static"]()
     errors = replace(sim.preset("seed001"), accel_vrw=800.0 * UG)
     for name, extra in (("measured", {}), ("configured", dict(fine_noise=abi.PYINS_FINE_NOISE_CONFIGURED))):
-        res = runner.navigate(motion, COARSE + 6_000, every=10, sensors=sim.SensorModel(errors, seed=0),
+        res = open_loop.navigate(motion, COARSE + 6_000, every=10, sensors=sim.SensorModel(errors, seed=0),
                               config=dict(coarse_ticks=COARSE, coarse_method=abi.PYINS_COARSE_FIT,
                                           fine_ticks=6_000, fine_states=5, **extra))
         out = res.outputs
@@ -133,7 +133,7 @@ def test_the_mirror_measures_the_same_noise(method):
     errors = replace(sim.preset("seed001"), accel_vrw=300.0 * UG)
     got = {}
     for engine in ("native", "reference"):
-        res = runner.navigate(motion, 3_300, every=50, sensors=sim.SensorModel(errors, seed=3), engine=engine,
+        res = open_loop.navigate(motion, 3_300, every=50, sensors=sim.SensorModel(errors, seed=3), engine=engine,
                               config=dict(coarse_ticks=3_000, coarse_method=method, coarse_first_output_ticks=1_000,
                                           fine_ticks=300, fine_states=8))
         got[engine] = res.outputs

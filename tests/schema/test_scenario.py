@@ -11,7 +11,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from pyins import metrics, runs, scenario, sim
+from pyins import metrics, run_scenario, scenario, sim
 from pyins.reference import attitude
 from pyins.scenario import ScenarioError
 from pyins.units import UNITS, parse_quantity
@@ -545,9 +545,9 @@ def test_smoke_builtin_run_equals_the_reproduce_tool_run():
     sc = scenario.load("seed002_exp1").with_overrides({"duration": "5 s", "record_every": "0.5 s"})
     run = list(sc.runs())[2]
     assert run.label == "flexible two-position" and run.duration_ticks == 500 and run.every == 50
-    ours = runs.run(run)
+    ours = run_scenario.run(run)
     vid, tool_run = tool.variants(1, {"duration": "5 s", "record_every": "0.5 s"})[2]
-    assert vid == "4" and runs.run(tool_run).outputs.tobytes() == ours.outputs.tobytes()
+    assert vid == "4" and run_scenario.run(tool_run).outputs.tobytes() == ours.outputs.tobytes()
     m = sim.HeadingSwing.experiment(1)
     theirs = fil.run_fil(m, 500, config=dict(index_scheme=4, **seed002_initial_errors(m)),
                          errors=sim.preset("seed002"), seed=1, every=50)

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyins import runs, scenario, sim
+from pyins import run_scenario, scenario, sim
 from pyins.reference import earth
 from pyins.scenario import ScenarioError
 from pyins import units
@@ -302,12 +302,12 @@ def test_smoke_moored_run_equals_a_direct_fil_run():
     cfg = dict(coarse_ticks=3000, coarse_method=1, coarse_output_every_ticks=200, coarse_ratio=0.5,
                euler_b_rad=[0.0, 0.0, 0.0], index_scheme=0)
     fit = list(sc.runs())[1]
-    ours = runs.run(fit)
+    ours = run_scenario.run(fit)
     theirs = fil.run_fil(m, 3000, config=cfg, errors=tool.sensors(seed=240007)[1], seed=240007, every=200)
     assert len(ours.outputs) == 15 and ours.outputs.tobytes() == theirs.outputs.tobytes()
     # the truth is the reference point's: zero lever arm -> the same position, another velocity
     assert np.array_equal(ours.truth.lat, m.reference_state(ours.outputs["tick"] * 0.01).lat)
-    unknown = runs.run(list(sc.with_overrides({"firmware.lever": "unknown"}).runs())[1])
+    unknown = run_scenario.run(list(sc.with_overrides({"firmware.lever": "unknown"}).runs())[1])
     theirs_u = fil.run_fil(m, 3000, config=dict(cfg, lever_b_m=np.zeros(3), lever_p_m=np.zeros(3)),
                            errors=tool.sensors(seed=240007)[1], seed=240007, every=200)
     assert unknown.outputs.tobytes() == theirs_u.outputs.tobytes() != ours.outputs.tobytes()

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from pyins import fil, metrics, runner, sim
+from pyins import fil, metrics, open_loop, sim
 from pyins.reference import earth
 from pyins.sim import imu
 from pyins.sim import motion as M
@@ -303,8 +303,8 @@ def _errors_at_imu(motion, table=None, config=None):
         cfg.update(lat_rad=st0.lat[0], lon_rad=st0.lon[0], height_m=st0.height[0],
                    vel_n_mps=st0.vel_n[0], euler_b_rad=st0.euler[0])
     cfg.update(config or {})
-    res = runner.navigate(motion, 360_000, every=100, table=table, config=cfg)
-    e = metrics.nav_errors(runner.RunResult(res.outputs, imu_view(res.truth), res.dt))
+    res = open_loop.navigate(motion, 360_000, every=100, table=table, config=cfg)
+    e = metrics.nav_errors(open_loop.RunResult(res.outputs, imu_view(res.truth), res.dt))
     up = res.outputs["height_m"] - res.truth.imu_height
     return res, e, up
 
@@ -369,11 +369,11 @@ def test_firmware_navigates_a_sensor_turning_on_the_table_1h():
 def test_fil_plant_runs_a_moored_ship_like_the_open_loop():
     # The compiled plant takes b-frame rates at the nodes (lever_b included)
     # once per period (12000 ticks) and turns them itself: with the table at
-    # rest it must match runner.navigate to rounding (measured 4e-14 rad).
+    # rest it must match open_loop.navigate to rounding (measured 4e-14 rad).
     ship = S.moored("general", *XIAN, 0.0, 240.0 * D)
     assert sim.periodic_ticks(ship, DT) == 12000
     a = fil.run_fil(ship, 60_000, every=100)
-    b = runner.navigate(ship, 60_000, every=100)
+    b = open_loop.navigate(ship, 60_000, every=100)
     assert np.max(np.abs(a.outputs["lat_rad"] - b.outputs["lat_rad"])) < 1e-12   # 6 um
     assert np.max(np.abs(a.outputs["vel_n_mps"] - b.outputs["vel_n_mps"])) < 1e-8
     np.testing.assert_array_equal(a.truth.imu_lat, b.truth.imu_lat)

@@ -27,7 +27,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reproduce_seed002 import ERROR_SETS, SCENARIOS  # noqa: E402
 
-from pyins import analysis, metrics, runs, scenario  # noqa: E402
+from pyins import analysis, metrics, run_scenario, scenario  # noqa: E402
 from pyins import progress as progress_bars  # noqa: E402
 from pyins.units import NMI_TO_M, TICK_HZ  # noqa: E402
 
@@ -61,7 +61,7 @@ def spec_of(name, scheme, sums, accel_deg, hours):
 
 
 def run_one(spec, progress):
-    res = runs.run(spec, progress=progress)
+    res = run_scenario.run(spec, progress=progress)
     e = metrics.nav_errors(res)
     return {"max_nmi": float(e.horizontal_m.max() / NMI_TO_M),
             "final_nmi": float(e.horizontal_m[-1] / NMI_TO_M),

@@ -46,7 +46,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, campaign, metrics, runner, scenario, sim
+from pyins import analysis, campaign, metrics, open_loop, scenario, sim
 from pyins.reference.config import DEFAULT_COARSE_FIRST_S
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import ARCSEC_TO_RAD as ARCSEC
@@ -123,9 +123,9 @@ def campaign_specs(name, n_seeds, overrides=None):
 
 
 def navigate(spec):
-    """One alignment of ``spec``, open loop (pyins.runner.navigate, no turntable), its sensor
+    """One alignment of ``spec``, open loop (pyins.open_loop.navigate, no turntable), its sensor
     noise drawn from its seed."""
-    res = runner.navigate(spec.motion, spec.duration_ticks, every=spec.every,
+    res = open_loop.navigate(spec.motion, spec.duration_ticks, every=spec.every,
                           sensors=sim.SensorModel(spec.errors, seed=spec.seed), config=spec.config)
     return res, metrics.nav_errors(res)
 

@@ -37,7 +37,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, metrics, runs, scenario
+from pyins import analysis, metrics, run_scenario, scenario
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
 from pyins.units import DPH_TO_RPS as DPH
@@ -66,7 +66,7 @@ def run(states, seed, correction="open_loop", overrides=None):
     ``correction`` ("open_loop" or "feedback") and further scenario ``overrides``."""
     o = {"seed": seed, "firmware.fine_correction": correction, **(overrides or {})}
     (spec,) = scenario.load(SCENARIOS[states]).with_overrides(o).runs()
-    res = runs.run(spec)
+    res = run_scenario.run(spec)
     lim = analysis.alignment_limits(spec.motion.lat, spec.motion.euler0, spec.errors.gyro_bias,
                                     spec.errors.accel_bias)
     return res, metrics.nav_errors(res), lim

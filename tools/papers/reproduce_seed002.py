@@ -35,7 +35,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, metrics, progress, runs, scenario
+from pyins import analysis, metrics, progress, run_scenario, scenario
 from pyins.reference.config import DEFAULT_INDEX_ACCEL
 from pyins.units import DEG_TO_RAD as DEG
 from pyins.units import NMI_TO_M, TICK_HZ
@@ -79,7 +79,7 @@ VIDS = tuple(vid for vid, _ in variants(1, {}))
 
 
 def run_one(spec):
-    res = runs.run(spec, progress=progress.TextProgress())
+    res = run_scenario.run(spec, progress=progress.TextProgress())
     e = metrics.nav_errors(res)
     # the proxy of docs/papers.md, seed 002 §10, split into the stopped and the turning part,
     # at the full rate: integrated over the analytic swing and the table's history between

@@ -25,7 +25,7 @@ import sys
 
 import numpy as np
 
-from pyins import analysis, metrics, progress, runs, scenario
+from pyins import analysis, metrics, progress, run_scenario, scenario
 from pyins.units import ARCMIN_TO_RAD as ARCMIN
 from pyins.units import DEG_TO_RAD as DEG
 from pyins.units import NMI_TO_M, TICK_HZ
@@ -89,7 +89,7 @@ def main(argv=None):
     for spec, spec_b in zip(specs, sc.with_overrides(BIASES_ONLY).runs()):
         label, errors = spec.label, spec.errors
         up_only = np.array([0.0, 0.0, errors.gyro_bias[2]])
-        res = runs.run(spec, progress=progress.TextProgress())
+        res = run_scenario.run(spec, progress=progress.TextProgress())
         e = metrics.nav_errors(res)
         # error theory with the same constant drifts and biases, and split by source
         theory = {
@@ -104,7 +104,7 @@ def main(argv=None):
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_max_{k}"] = float(v)
         # the same run with the constant drifts and biases only: what theory covers
-        res_b = runs.run(spec_b)
+        res_b = run_scenario.run(spec_b)
         rows.append((f"ours, {label}, constant drifts and biases only", figures(metrics.nav_errors(res_b))))
         for k, v in rows[-1][1].items():
             fig_json[f"{tag}_biases_only_max_{k}"] = float(v)

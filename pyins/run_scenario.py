@@ -1,0 +1,163 @@
+"""Running a scenario: one run of it through the firmware in the loop
+(`run`) and every variant into a run directory (`execute`, what ``pyins
+run`` does). The directory's layout and reading it back are
+`pyins.rundir`; a recorded log through the firmware (``pyins replay``) is
+`pyins.replay`.
+
+Runs are checkpointed (every CHECKPOINT_S of ship time): ``execute(...,
+resume=True)`` after a kill or Ctrl-C continues each unfinished variant from
+its last checkpoint and skips the finished ones. summary.json is written at
+the start (``"state": "running"``), after every variant and at the end,
+atomically; Ctrl-C writes it at once (``"complete": false``, ``"state":
+"interrupted"``) and leaves the stopped variant's metrics to the report
+(`pyins.report.run.load` reads its records on disk), so a stop takes under
+a second. A directory being written is locked (`pyins.records.lock_dir`);
+one holding another scenario's run is refused (`pyins.rundir.check_run_dir`).
+
+Every entry point takes ``engine``: "native" (the compiled firmware and
+plant) or "reference" (their NumPy mirrors, `pyins.engine`).
+"""
+import os
+import shutil
+import time
+
+from pyins import engine as engines
+from pyins import fil, metrics, native, records
+from pyins.metrics import group_metrics
+from pyins.progress import phase
+from pyins.rundir import (check_run_dir, hold_interrupts, load_variant, slug, variant_facts, write_summary,
+                          written_durations, written_ticks)
+from pyins.units import ARCMIN_TO_RAD
+
+__all__ = ["execute", "run", "CHECKPOINT_S"]
+
+CHECKPOINT_S = 1800.0          # ship time between checkpoints: 30 min = 180,000 ticks
+
+
+def run(spec, engine="native", **kwargs):
+    """One run of a scenario (a pyins.scenario.RunSpec) through the firmware
+    in the loop; ``kwargs`` go to ``fil.run_fil`` (record_dir, resume,
+    progress, ...). Returns a records.FilResult."""
+    return fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=spec.errors,
+                       seed=spec.seed, table=spec.table, every=spec.every, dt=spec.dt, engine=engine,
+                       **kwargs)
+
+
+def _entry(spec, written):
+    return dict(label=spec.label, dir=slug(spec.label), ticks=spec.duration_ticks, ticks_done=0,
+                complete=False, wall_s=0.0, metrics={}, **variant_facts(spec, written))
+
+
+def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native", force=False,
+            notice=None):
+    """Run every variant of ``scn`` (a pyins.scenario.Scenario) into
+    ``run_dir``; returns the summary dict (also written to summary.json).
+
+    ``progress(label)`` returns a callable progress(done, total) per variant
+    (e.g. ``lambda label: TextProgress()``; one with a ``phase`` method, as
+    TextProgress has, also gets a line for the variant's metrics and time
+    series); ``log(text)`` gets one line per
+    finished variant, ``notice(text)`` the takeover of a stale lock.
+
+    The directory is locked while written (`pyins.records.lock_dir`: a
+    second writer gets LockedError naming the holder). A directory holding
+    another scenario's run is refused (RunDirError) unless ``force``.
+    summary.json is written at the start (``"state": "running"``), after
+    every variant and at the end, each time atomically, so a kill leaves
+    one that `pyins report` reads. KeyboardInterrupt is caught anywhere in
+    the variants: the summary of what was done is written at once
+    (``"complete": false``, ``"state": "interrupted"``; the stopped
+    variant's ticks done, its metrics left to the report) and the interrupt
+    re-raised.
+    """
+    # the guarded prefix
+    engines.check(engine)
+    # the lock and the first files together, Ctrl-C held off: a run that started has a summary
+    lock = None
+    try:
+        with hold_interrupts() as held:
+            lock = records.lock_dir(run_dir, notice=notice)
+            summary, specs, resume = _start(scn, run_dir, resume, engine, force)
+        return _variants(summary, specs, run_dir, progress, resume, log, engine,
+                         KeyboardInterrupt() if held.interrupted else None)
+    finally:
+        if lock is not None:
+            with hold_interrupts():          # a second Ctrl-C must not leave the lock file behind
+                lock.release()
+
+
+def _start(scn, run_dir, resume, engine, force):
+    # 1. the run directory: refused if another's; the scenario as written and as resolved
+    if check_run_dir(scn, run_dir, force) == "new":
+        resume = False
+    src = scn.source if scn.source and os.path.exists(str(scn.source)) else None
+    # the resolved scenario first: it names the run (its digest), so a kill after it
+    # leaves a directory a resume recognises
+    records.write_atomic(os.path.join(run_dir, "resolved_scenario.json"), scn.resolved_json())
+    records.write_atomic(os.path.join(run_dir, "scenario.toml"), scn.text)
+    specs = list(scn.runs())
+    written = written_durations(scn)
+    summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
+                   digest=scn.digest(), core_version=native.version(), paper=scn.paper,
+                   variants=[_entry(spec, written) for spec in specs], complete=False, state="running",
+                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name))
+    if engine != "native":
+        summary["engine"] = engine
+    write_summary(run_dir, summary)
+    return summary, specs, resume
+
+
+def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupted):
+    # 2. each variant: the checkpointed run, its records, metrics and time series
+    for i, spec in enumerate(specs):
+        vdir = os.path.join(run_dir, slug(spec.label))
+        entry = summary["variants"][i]
+        t0 = time.perf_counter()
+        try:
+            if interrupted is not None:
+                raise interrupted
+            if not resume and os.path.exists(vdir):
+                shutil.rmtree(vdir)
+            os.makedirs(vdir, exist_ok=True)
+            for name in ("timeseries.npz", "timeseries.csv"):      # derived: rewritten at the end
+                if os.path.exists(os.path.join(vdir, name)):
+                    os.remove(os.path.join(vdir, name))
+            checkpoint = int(round(CHECKPOINT_S / spec.dt))
+            bar = progress(spec.label) if progress else None
+            run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
+                checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint), progress=bar)
+            with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
+                res, info = load_variant(run_dir, spec)
+                mm = metrics.run_metrics(spec, res) if res is not None else {}
+                if res is not None and len(res.outputs):
+                    records.write_timeseries(vdir, res)
+            entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
+                         complete=bool(info and info.get("complete")), metrics=mm)
+        except KeyboardInterrupt as exc:
+            # at once: the ticks on disk; the metrics of a stopped variant are the report's
+            interrupted = interrupted or exc.with_traceback(None)
+            with hold_interrupts():
+                entry.update(wall_s=time.perf_counter() - t0, complete=False, metrics={},
+                             ticks_done=written_ticks(run_dir, spec) if os.path.isdir(vdir) else 0)
+            continue
+        if log is not None:
+            log(f"  {spec.label}: {entry['ticks_done'] * spec.dt / 3600:.3g} h, "
+                f"max horizontal error {mm.get('horizontal_error_max', float('nan')):.1f} m, "
+                f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
+                f"({entry['wall_s']:.1f} s)")
+        try:
+            with hold_interrupts(defer=True):
+                write_summary(run_dir, summary)
+        except KeyboardInterrupt as exc:       # during the write (raised after it) or just before
+            interrupted = exc.with_traceback(None)
+
+    # 3. the summary, over the variants
+    with hold_interrupts(defer=interrupted is None):
+        summary["group_metrics"] = group_metrics(summary["variants"])
+        summary["complete"] = all(v["complete"] for v in summary["variants"])
+        summary["state"] = "interrupted" if interrupted is not None else (
+            "complete" if summary["complete"] else "partial")
+        write_summary(run_dir, summary)
+    if interrupted is not None:
+        raise interrupted
+    return summary
