@@ -1,8 +1,12 @@
 // coarse_align.hpp: inertial-frame coarse alignment on a static or rocking
 // base (seed 000: Gao Chunfeng et al., Infrared and Laser Engineering 2014,
-// no. 2, pp. 375-381), written for the IMU frame p.
+// no. 2, pp. 375-381), and on a moored ship (method FIT), written for the
+// IMU frame p.
 //
-// Mirrored by pyins/reference/coarse_align.py.
+// Mirrored by pyins/reference/coarse_align.py. Measurements and design
+// notes: docs/core.md, "Coarse alignment (seed 000)" and "Eq. 8 as
+// printed"; docs/concepts.md, "Alignment on a moving base" and "Integrity";
+// docs/papers.md, seed 000.
 //
 //   C_p^n(t) = C_e^n C_i^e(t) C_ib0^i C_p^ib0(t)                 (seed 000 eq. 1)
 //
@@ -13,30 +17,26 @@
 // - v^i(t) = integral of f^i dt in closed form (seed 000 eq. 5): with the e
 //   frame's x axis on the site meridian and f^e = g [cosL, 0, sinL],
 //     v^i = g [cosL sin(wt)/w, cosL (1 - cos(wt))/w, sinL t].
-//   The paper prints the negative (it integrates gravity, not specific force);
-//   both sides of eq. 8 flip together. 1 - cos(wt) is computed as
-//   2 sin^2(wt/2), which does not cancel for small wt.
+//   Correction: the paper prints the negative (it integrates gravity, not
+//   specific force); both sides of eq. 8 flip together. 1 - cos(wt) is
+//   computed as 2 sin^2(wt/2), which does not cancel for small wt.
 // - C_ib0^i from the vector pairs at t_k1 = r t_k2 and t_k2 = now (eqs. 6-8).
-//   Eq. 8 as printed inverts a 3x3 matrix of the two vectors and their cross
-//   product: under noise the result is not orthonormal. Here the two pairs go
-//   through the TRIAD (dual-vector) construction, anchored on v(t_k2) (the
-//   longer integral, which averages the swing best); the result is a proper
-//   rotation by construction.
+//   Correction: eq. 8 as printed inverts a 3x3 matrix of the two vectors and
+//   their cross product, which under noise is not orthonormal. Here the two
+//   pairs go through the TRIAD (dual-vector) construction, anchored on
+//   v(t_k2) (the longer integral, which averages the swing best); the
+//   result is a proper rotation by construction.
 // - Method EQ8: eq. 8 as printed, C_ib0^i = A^-1 B with the rows of A
 //   v^i(t_k1), v^i(t_k2), v^i(t_k1) x v^i(t_k2) and of B the same in ib0
-//   (same t_k1, same history, same lever velocity as TRIAD). A^-1 is the
-//   adjugate over the determinant, the exact inverse. The specific-force sign
-//   flips the first two rows of A and B together (D A, D B with D =
-//   diag(-1, -1, 1)) and (D A)^-1 D B = A^-1 B: the print's sign does not
-//   matter. The paper substitutes the matrix into eq. 1 without
-//   orthonormalising it, and so does the core: under noise or biases C_ib0^i
-//   is a rotation times a small non-orthogonal, non-unit factor (the two
-//   vectors' errors, unweighted: t_k1's error counts as much as t_k2's). The
-//   attitude is read off eq. 1's product as the paper reads it: its Euler
-//   angles (pitch from C32, roll from C31, C33, yaw from C12, C22), whose
-//   rotation mat_n_p returns (Shepperd's quaternion of the raw product
-//   depends on its branch, i.e. on the heading). The wander test reads the
-//   skew part of R^T C. On error-free data it equals TRIAD's solution.
+//   (same t_k1, history and lever velocity as TRIAD); A^-1 is the adjugate
+//   over the determinant, the exact inverse. The print's sign does not
+//   matter: with D = diag(-1, -1, 1), (D A)^-1 D B = A^-1 B. As in the
+//   paper the matrix goes into eq. 1 without orthonormalisation, and the
+//   attitude is read off the product as its Euler angles (pitch from C32,
+//   roll from C31, C33, yaw from C12, C22), whose rotation mat_n_p returns
+//   (Shepperd's quaternion of a matrix that is not a rotation depends on
+//   its branch, i.e. on the heading). The wander test reads the skew part
+//   of R^T C.
 // - The v^ib0 history is kept on a grid of output_every ticks in fixed storage
 //   (kHistLen entries, no heap); t_k1 is the grid point nearest r t_k2.
 //
@@ -50,26 +50,24 @@
 // differentiated from the gyro.
 //
 // Moving base (method FIT). Eq. 4 assumes that the disturbance integrates to
-// zero; a moored ship heaves, surges and sways, and its velocity at t0 is
-// unknown, so the velocity integral carries v_D(t) - v_D(t0): a bounded wave
-// velocity plus an unknown constant. On seed 000's general swing with 0.3 m
-// of surge and sway at 10-12 s and 0.5 m of heave at 8 s, TRIAD is ~160' off
-// in heading at 200 s. FIT integrates once more, P(t) = integral of v dt, so
-// that the disturbance is a bounded displacement plus a linear term
-// -v_D(t0) t + const, and then projects both P^ib0 and P^i on two weight
-// functions of s = t / T that are orthogonal to 1 and s (the unknown initial
-// velocity and offset drop out) and vanish with their slope at both ends
-// (a wave's leakage falls as (w T)^-3):
+// zero; on a moored ship the velocity integral carries v_D(t) - v_D(t0), a
+// bounded wave velocity plus an unknown constant. FIT integrates once more,
+// P(t) = integral of v dt, so that the disturbance is a bounded displacement
+// plus a linear term -v_D(t0) t + const, and projects both P^ib0 and P^i on
+// two weight functions of s = t / T that are orthogonal to 1 and s (the
+// unknown initial velocity and offset drop out) and vanish with their slope
+// at both ends (a wave's leakage falls as (w T)^-3):
 //   phi_a(s) = s^2 (1-s)^2 q_a(s), also orthogonal to s^3: picks the t^2
 //              term of gravity, int phi_a s^2 ds = 1;
 //   phi_b(s) = s^2 (1-s)^2 q_b(s), also orthogonal to s^2: picks the t^3
 //              term the Earth's rotation adds (g cos L w t^3 / 6 on y_i),
-//              int phi_b s^3 ds = 1.
-// The two pairs of weighted sums go through the same TRIAD, anchored on the
-// gravity pair. The static-base limit is the same as TRIAD's (the biases
-// enter the t^2 and t^3 terms as in the classical analytic alignment).
-// P^i is closed form: g [cosL (1 - cos wt) / w^2, cosL (wt - sin wt) / w^2,
-// sinL t^2 / 2], by its series (no cancellation, no trigonometry).
+//              int phi_b s^3 ds = 1
+// (tools/derive_coarse_fit.py derives the weights). The two pairs of
+// weighted sums go through the same TRIAD, anchored on the gravity pair.
+// The static-base limit is the same as TRIAD's (the biases enter the t^2
+// and t^3 terms as in the classical analytic alignment). P^i is closed
+// form: g [cosL (1 - cos wt) / w^2, cosL (wt - sin wt) / w^2, sinL t^2 / 2],
+// by its series (no cancellation, no trigonometry).
 //
 // Integrity: C_ib0^i is a constant; a solution that converges stops moving.
 // From the first output at or after settle_from (the last fifth of the
@@ -77,25 +75,22 @@
 // first one, and the largest rotation between them is kept as its sine
 // (`wander`; 1 for 90 deg or more). Every coarse solution is provisional:
 // the firmware reports none with PYINS_STATE_ATT_VALID before the alignment
-// has ended and passed this test. On a moored ship TRIAD moves by tens of
-// arc-minutes over that fifth (164-326' with seed 000's errors), FIT by
-// < 1.5' over 300 s and up to 11' over 120 s (its noise then).
+// has ended and passed this test.
 //
-// Noise (for the fine alignment's R). The fine alignment that follows
-// measures the specific force averaged over tau = noise_every ticks; its R
-// must be the variance of that mean, which on a real site is the sensor
-// noise plus vibration (the PSINS laser-gyro log of a parked vehicle:
-// ~800 ug/sqrt(Hz) at tau = 0.1 s against a 10 ug/sqrt(Hz) default). The
-// coarse phase measures it on the same interval: m_k, the reference point's
-// mean specific force in ib0 over block k (attitude motion removed by
-// C_p^ib0, the lever velocity removed as above), and its second difference
+// Noise (for the fine alignment's R; docs/core.md, "Measurement noise of
+// the fine alignment"). The static fine filters measure the specific force
+// averaged over tau = noise_every ticks; their R must be the variance of
+// that mean, on a real site the sensor noise plus vibration. The coarse
+// phase measures it on the same interval: m_k, the reference point's mean
+// specific force in ib0 over block k (attitude motion removed by C_p^ib0,
+// the lever velocity removed as above), and its second difference
 // d_k = m_k - 2 m_(k-1) + m_(k-2) = (V_k - 3 V_(k-1) + 3 V_(k-2) - V_(k-3)) / tau
 // (V: v^ib0 at the block ends), which cancels any trend linear over 3 tau
-// (the Earth's rotation of gravity in ib0, a bias drift, a wave's slow
-// acceleration: 0.1 m/s^2 at 0.1 Hz leaves 2 % of the variance of 10 ug/sqrt(Hz)).
-// For white noise of density q, Var(d) = 6 q^2 / tau per axis; of the two
-// horizontal axes (d less its component along v^ib0, the direction of the
-// mean specific force, i.e. up):
+// (the Earth's rotation of gravity in ib0, a bias drift) and scales a
+// sinusoid of angular frequency w (a wave's slow acceleration) by
+// (2 sin(w tau / 2))^2 ~ (w tau)^2. For white noise of density q,
+// Var(d) = 6 q^2 / tau per axis; of the two horizontal axes (d less its
+// component along v^ib0, the direction of the mean specific force, i.e. up):
 //   q^2 = tau / 6 * mean(|d_h|^2) / 2.
 #pragma once
 

@@ -37,9 +37,9 @@ inline constexpr double kDefaultFineSigmaAtt[3] = {100.0 * kArcminToRad, 100.0 *
 // (without a coarse phase; after one the static filters fit the attitude
 // sigmas to the coarse result, capped at these: fine_align::sigma0_after_coarse)
 /// Moving base: the initial attitude sigma is what FIT leaves after 120 s or
-/// more on a navigation-grade IMU (level ~2", heading ~4' from the limit,
-/// tools/papers/moored_alignment.py), with margin: 1', 1', 10'. Seed 001's 600' of
-/// heading let the wave noise swing the early heading by 80' (measured).
+/// more on a navigation-grade IMU, with margin: 1', 1', 10' (seed 001's 600'
+/// of heading lets the wave noise swing the early heading; docs/concepts.md,
+/// "Alignment on a moving base").
 inline constexpr double kDefaultMovingSigmaAtt[3] = {1.0 * kArcminToRad, 1.0 * kArcminToRad,
                                                      10.0 * kArcminToRad};
 inline constexpr double kDefaultFineSigmaGyro = 0.01 * kDegToRad / 3600.0;
@@ -54,11 +54,10 @@ inline constexpr double kDefaultIndexJump = 5.0 * kDegToRad;
 inline constexpr int32_t kDefaultIndexTimeoutS = 2;
 inline constexpr int32_t kDefaultStopSeed003S = 60;
 inline constexpr int32_t kDefaultStopS = 300;
-/// Sample-level faults (docs/core.md). Saturation defaults: 400 deg/s and
-/// 20 g per axis, the order of a navigation-grade RLG IMU's range (the
-/// issue's figures); a ship stays far below (seed 000's bad sea state peaks
-/// at 23 deg/s and 0.3 g beyond gravity), so only a saturated sensor (a
-/// shock) or a corrupted word reaches them.
+/// Sample-level faults (docs/core.md, "Sample-level faults", which says why
+/// a ship stays far below them). Saturation defaults: 400 deg/s and 20 g per
+/// axis, the order of a navigation-grade RLG IMU's range: only a saturated
+/// sensor (a shock) or a corrupted word reaches them.
 inline constexpr double kDefaultSatGyroRate = 400.0 * kDegToRad;      ///< [rad/s]
 inline constexpr double kDefaultSatAccel = 20.0 * kG0;       ///< [m/s^2]
 /// Longest gap bridged by interpolation [ticks]; see docs/core.md for the
@@ -70,11 +69,10 @@ inline constexpr int32_t kMaxSeqGap = 100;
 /// Longest lever arm accepted [m]: a ship's IMU is metres from its reference
 /// point; beyond 100 m the number is a unit mistake (mm or inches).
 inline constexpr double kMaxLeverM = 100.0;
-/// Integrity defaults (docs/concepts.md, "Integrity"): 100 updates (10 s at
-/// 10 Hz) per NIS window and a bound of 4 on its mean (10 sigma of a
-/// consistent window); the coarse solution may wander 30' over its last
-/// fifth (measured on the moored ship with seed 000's errors: FIT over 120 s
-/// wanders 2.7-10.9', over 300 s < 1.5'; TRIAD over 300 s 164-326').
+/// Integrity defaults (docs/concepts.md, "Integrity", which holds what FIT
+/// and TRIAD wander on the moored ship): 100 updates (10 s at 10 Hz) per NIS
+/// window and a bound of 4 on its mean (10 sigma of a consistent window);
+/// the coarse solution may wander 30' over its last fifth.
 inline constexpr int32_t kDefaultNisWindow = 100;
 inline constexpr double kDefaultNisMax = 4.0;
 inline constexpr double kDefaultCoarseWander = 30.0 * kArcminToRad;

@@ -20,26 +20,24 @@
 // projected into n is meant). P0 = diag(sigma0)^2 with seed 001's
 // sigma0 = 10 x [10', 10', 60', 0.001 deg/h, 0.001 deg/h] by default.
 // After a coarse alignment an attitude sigma left 0 fits the coarse result
-// instead (sigma0_after_coarse; docs/core.md, "Fine alignment after a
-// coarse one"): seed 001's 600' of heading let the first updates swing the
-// heading by 5.7-9.5 deg on a quiet simulated site and by 162 deg on the
-// real PSINS laser-gyro log (measured), although the coarse heading was
-// right to a few arc-minutes.
+// instead (sigma0_after_coarse below): seed 001's 600' of heading lets the
+// first updates swing a heading the coarse phase had right to arc-minutes.
 // Integrity: the normalised innovation squared of each update (chi-square,
 // 2 degrees of freedom, mean 2 while the model holds) is averaged over
 // windows of nis_window updates; a window mean beyond nis_max says the
 // measurements do not fit the static-base model (a heaving ship, an unknown
 // lever arm, a noise density set too low) and clears `consistent` for good.
-// Until the first window is complete the firmware reports the estimate as
-// provisional (not valid): in its first second a wide prior lets the filter
-// take a wave's acceleration for a tilt of tens of arc-minutes unnoticed.
-// With 100 updates the mean of a consistent window has a sigma of 0.2: the
-// default bound 4 is 10 sigma, while 0.1 m/s^2 of wave acceleration against
-// R = (10 ug/sqrt(Hz))^2 / 0.1 s gives a mean NIS ~1e7.
+// With 100 updates the mean of a consistent window has a sigma of
+// sqrt(4 / 100) = 0.2: the default bound 4 is 10 sigma. Until the first
+// window is complete the firmware reports the estimate as provisional (a
+// wide prior lets the first updates take a wave's acceleration for a tilt).
 // Feedback (recommended by the paper; the firmware's choice, not this
 // module's): after each update the attitude is corrected by phi^ and phi^
 // reset to zero (reset_phi); open loop leaves the attitude alone and reports
 // the corrected one.
+// Measurements and design notes: docs/core.md, "Fine alignment (seed 001)",
+// "Fine alignment after a coarse one" and "Measurement noise of the fine
+// alignment"; docs/concepts.md, "Integrity"; docs/papers.md, seed 001.
 #pragma once
 
 #include <cstdint>

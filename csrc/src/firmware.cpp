@@ -615,8 +615,7 @@ void Firmware::bridge(int32_t missing, const Vec3& dtheta_p, const Vec3& dv_p, d
     // missing ticks lie between them, and both are at hand when the gap is
     // seen): exact while the rate and specific force change linearly over
     // the gap, where repeating the last increments is exact only while they
-    // are constant; on seed 000's bad sea state one missing tick leaves 0.19"
-    // of attitude error against 20" (docs/core.md, "Sample-level faults").
+    // are constant (docs/core.md, "Sample-level faults", measures both).
     // Uniform motion is bridged bit-exactly (the difference is 0).
     // (the last sample's increments are read in place: advance does not
     // change them, and copies would add 48 bytes to the deepest stack path)

@@ -28,9 +28,9 @@ enum class Mode : int32_t {
 };
 
 /// A fine-alignment attitude is valid only once the filter's own heading
-/// sigma is within 10' (the bound the integrity acceptance uses): on PSINS's
-/// real laser-gyro log seed 001's 600' prior let the static filter wander
-/// 45' from its final heading while its sigma was still 440' (measured).
+/// sigma is within 10' (the bound the integrity acceptance uses): from a
+/// wide prior the heading wanders far while its sigma is still large
+/// (docs/concepts.md, "Integrity": PSINS's real laser-gyro log).
 inline constexpr double kValidHeadingSigma = 10.0 * kArcminToRad;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;

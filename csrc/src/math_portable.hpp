@@ -59,10 +59,10 @@
 //     atan(t), t = (y - c x) / (x + c y), |t| <= 1/128; below 1/64 the
 //     quotient with its Dekker remainder; the series to t^9; atan(i/64)
 //     stored as double-doubles (tools/derive_atan_table.py; Muller,
-//     "Elementary Functions", 2016, ch. 6). Two divisions, not four: ~117
-//     instructions a call on x86-64 against 147, ~2,500 fewer on the
-//     Cortex-M4F. Against glibc it differs by 1 ulp on 0.02-0.5 % of each
-//     test set (0.2 % of points aimed at its own edges), never by more.
+//     "Elementary Functions", 2016, ch. 6). Two divisions, not four (the
+//     cost a call: docs/benchmarks.md). Against glibc it differs by 1 ulp
+//     on 0.02-0.5 % of each test set (0.2 % of points aimed at its own
+//     edges), never by more.
 #pragma once
 
 #include <cmath>

@@ -1,19 +1,18 @@
 // moving_align.hpp: moving-base Kalman fine alignment of a moored ship by
 // position matching, 12 states, for the IMU frame p.
 //
-// Mirrored by pyins/reference/moving_align.py.
+// Mirrored by pyins/reference/moving_align.py. Measurements and design
+// notes: docs/concepts.md, "Alignment on a moving base" and "Integrity".
 //
-// Why: seed 001's static filters measure the specific force in n; on a
-// heaving ship that carries the waves' acceleration (0.01-0.1 m/s^2 against
-// the ug the level needs) and they fail (their NIS test flags it). Here the
-// strapdown runs free in the horizontal (the vertical channel held) and the
-// measurement is the reference point's position relative to the mooring
-// site: the waves enter as a displacement of tenths of a metre with zero
-// mean, which the filter takes as measurement noise; tilt and heading act
-// through the velocity and position errors they make grow (the velocity-
-// matching idea of PSINS's alignvn, in position, which the waves disturb
-// less: a wave's displacement is its acceleration / w^2, ~0.5 m at 8 s for
-// 0.3 m/s^2).
+// Why: seed 001's static filters measure the specific force in n, which on
+// a heaving ship carries the waves' acceleration, and they fail (their NIS
+// test flags it). Here the strapdown runs free in the horizontal (the
+// vertical channel held) and the measurement is the reference point's
+// position relative to the mooring site: a wave enters as a zero-mean
+// displacement, its acceleration / w^2, which the filter takes as
+// measurement noise; tilt and heading act through the velocity and
+// position errors they make grow (the velocity-matching idea of PSINS's
+// alignvn, in position, which the waves disturb less).
 //
 // States (phi as in fine_align: C_p^n' = (I - phi x) C_p^n; errors =
 // computed - true; eps, nabla in n, random constants):

@@ -15,13 +15,13 @@
 // Coning and sculling use the current and the two previous ticks' increments:
 // the coefficients are exact when the angular rate and specific force are
 // quadratic in time over those three ticks (tools/derive_coning.py derives
-// them with sympy). The textbook two-sample form (1/12) leaves a rectified
-// drift of 6e-5 deg/h on seed 000's bad sea state at 100 Hz (measured on exact
-// data); this form leaves 5e-8 deg/h. The velocity rotation compensation also
-// keeps the second-order term (1/6) dtheta x (dtheta x dv) (Savage 1998 Part
-// 2, eq. 26 expanded to second order): without it a swinging IMU sees a
-// rectified error of ~1 ug. The first two ticks after init, lacking history,
-// use the lower orders (no correction, then the two-sample 1/12 form).
+// them with sympy); the textbook two-sample form (1/12) leaves a rectified
+// drift on a swinging ship. The velocity rotation compensation also keeps
+// the second-order term (1/6) dtheta x (dtheta x dv) (Savage 1998 Part 2,
+// eq. 26 expanded to second order), without which a swinging IMU sees a
+// rectified velocity error. The first two ticks after init, lacking
+// history, use the lower orders (no correction, then the two-sample 1/12
+// form). Measurements: docs/core.md, "Coning and sculling: three samples".
 //
 // Earth terms: the radii, Earth rate and gravity depend on the position
 // alone, which a ship moves by well under a metre a tick. They are kept
@@ -31,17 +31,14 @@
 // (0.01 m) from where they were. A tick carries the latitude-dependent ones
 // (Earth rate, tan L, 1 / cos L) to its own latitude to first order in
 // d = L - L0 (the d^2 terms left out are < 1e-10 of themselves below 80 deg
-// of latitude): kept as they were, the Earth rate of a latitude 6 cm off
-// tilted a static ship's IMU turning on the table by 1e-9 rad in an hour
-// (2.5 mm), where the exact algorithm leaves 1e-6 m. What stays stale is
-// the radii's dependence on latitude and height, 1e-8 of themselves at most
-// (R_M: 3 e^2 sin L cos L per radian; 1 mm of position over 100 km).
-// Gravity is kept only while the vertical channel is held (then it reaches
-// nothing but that clamped channel); a free
-// channel's dynamics are gravity's own feedback (-2 g / R per metre,
-// e-folding in ~570 s), so it takes gravity at each tick's latitude and
-// height: 5e-10 m/s^2 of gravity from a latitude 6 cm stale moved it 8 mm
-// in an hour in the same test, where exact gravity leaves 3e-5 m.
+// of latitude; docs/core.md, "Earth quantities", says what the terms cost
+// without this carry). What stays stale is the radii's dependence on
+// latitude and height, 1e-8 of themselves at most (R_M: 3 e^2 sin L cos L
+// per radian; 1 mm of position over 100 km). Gravity is kept only while the
+// vertical channel is held (then it reaches nothing but that clamped
+// channel); a free channel's dynamics are gravity's own feedback (-2 g / R
+// per metre, e-folding in ~570 s), so it takes gravity at each tick's
+// latitude and height.
 //
 // Latitude sine and cosine (for those terms): the sine and cosine of an
 // anchor latitude L0 are kept, and those of L = L0 + d are its angle sums
