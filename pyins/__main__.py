@@ -363,7 +363,8 @@ def cmd_list(args):
     if "campaigns" in items:
         print("built-in campaigns (pyins campaign NAME):")
         for name, title in items["campaigns"]:
-            print(f"  {name:18s} {title}")
+            extra = f"  [{campaign.builtin_path(name)}]" if args.paths else ""
+            print(f"  {name:18s} {title}{extra}")
     print("sensor presets:", ", ".join(items["sensor_presets"]))
     print("indexing schemes:", ", ".join(items["index_schemes"]))
     print("log formats:", ", ".join(items["log_formats"]))

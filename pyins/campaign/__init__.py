@@ -23,7 +23,7 @@ The rooms:
   written (the command line, a campaign file);
 - `pyins.campaign.spec`: the campaign itself (`Campaign`, `Point`),
   validated and expanded into points and groups; loading campaign files and
-  the built-ins of pyins/campaigns/;
+  the built-ins of pyins/builtin/campaigns/;
 - `pyins.campaign.execute`: running the missing runs on a local process
   pool or a Dask cluster (`run_campaign`, `pending`);
 - `pyins.campaign.aggregate`: the statistics over the runs of each group in

@@ -22,7 +22,7 @@ Building a campaign (`_build`, whichever way it is written):
 7. the points, in grid order then seeds, and their groups.
 
 Written three ways: a campaign file (`load_campaign`, `loads_campaign`),
-a built-in of pyins/campaigns/ (`list_builtin`, `builtin_path`), or
+a built-in of pyins/builtin/campaigns/ (`list_builtin`, `builtin_path`), or
 command-line arguments (`from_args`).
 """
 import copy
@@ -51,7 +51,7 @@ from pyins.units import ScenarioError
 __all__ = ["Campaign", "Point", "load_campaign", "loads_campaign", "from_args", "list_builtin",
            "builtin_path", "default_out_dir", "BUILTIN_DIR", "CAMPAIGN_KEYS"]
 
-BUILTIN_DIR = Path(__file__).resolve().parent.parent / "campaigns"   #: the built-in campaigns
+BUILTIN_DIR = Path(__file__).resolve().parent.parent / "builtin" / "campaigns"   #: the built-in campaigns (data)
 CAMPAIGN_KEYS = ("name", "title", "description", "scenario", "seeds", "seed_formula", "group_by",
                  "compare", "grid", "set", "labels", "random_constants")
 

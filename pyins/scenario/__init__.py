@@ -27,7 +27,7 @@ the built-ins.
     >>> for run in sc.runs():                 # one RunSpec per [compare] value
     ...     result = run_scenario.run(run)    # pyins.run_scenario.run: fil.run_fil(...)  # doctest: +SKIP
 
-The built-in scenarios are TOML files in ``pyins/scenarios/`` (shipped in
+The built-in scenarios are TOML files in ``pyins/builtin/scenarios/`` (shipped in
 the wheel: scikit-build-core's ``wheel.packages = ["pyins"]`` copies every
 file of the package directory that git does not ignore, as it does for the
 headers CMake installs beside the library); `builtin_path` says where one
@@ -67,7 +67,7 @@ __all__ = ["load", "loads", "list_builtin", "builtin_path", "Scenario", "RunSpec
            "format_figure", "in_figure_unit", "initial_truth", "initial_config", "initial_errors",
            "TICK_HZ", "DT", "METRICS"]
 
-BUILTIN_DIR = Path(__file__).resolve().parent.parent / "scenarios"
+BUILTIN_DIR = Path(__file__).resolve().parent.parent / "builtin" / "scenarios"   #: the built-in scenarios (data)
 
 
 def _canonical(value):

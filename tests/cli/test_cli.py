@@ -4,6 +4,7 @@ with exit code 2, Ctrl-C leaves a valid partial result that --resume
 completes, and simulate -> replay closes the loop through a log file."""
 import json
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 
 from pyins import __main__ as cli
+from pyins import campaign, scenario
 
 COMMANDS = ["run", "simulate", "replay", "report", "campaign", "list", "bench", "demo", "version"]
 
@@ -178,6 +180,25 @@ def test_list_and_version(capsys):
     assert {"demo", "seed000_static", "seed001_fine5", "seed002_exp1", "seed002_exp2", "seed003"} <= set(names)
     assert cli.main(["version"]) == 0
     assert "core" in capsys.readouterr().out
+
+
+def test_list_paths_shows_every_builtin_file(capsys):
+    """`pyins list --paths`: each built-in scenario and campaign with the path of
+    its TOML file (the data under pyins/builtin/, beside the code that reads it)."""
+    assert cli.main(["list", "--paths"]) == 0
+    out = capsys.readouterr().out
+    shown = set()
+    for line in out.splitlines():
+        if line.startswith("  ") and line.endswith("]") and "  [" in line:
+            path = pathlib.Path(line.rsplit("  [", 1)[1][:-1])
+            shown.add((path.parent.name, line.split()[0], path))
+    want = {(kind, name) for kind, names in (("scenarios", scenario.list_builtin()),
+                                             ("campaigns", campaign.list_builtin())) for name, _ in names}
+    assert {(kind, name) for kind, name, _ in shown} == want and len(shown) == len(want)
+    assert {kind for kind, _ in want} == {"scenarios", "campaigns"}
+    for kind, name, path in shown:
+        assert path.is_file() and path.name == f"{name}.toml"
+        assert path.parent.parent.name == "builtin" and path.parent.parent.parent.name == "pyins"
 
 
 def test_campaign_from_the_command_line(tmp_path, capsys):

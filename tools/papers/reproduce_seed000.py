@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Reproduce seed 000 (inertial-frame coarse alignment) with the C++ firmware.
 The set-up is the built-in campaigns seed000_static and seed000_swing (their
-headings, seed formulas and base scenarios, pyins/campaigns/ and
-pyins/scenarios/); this driver varies it by overrides and adds the
+headings, seed formulas and base scenarios, pyins/builtin/campaigns/ and
+pyins/builtin/scenarios/); this driver varies it by overrides and adds the
 theoretical limits, tables and curves.
 
     .venv/bin/python tools/papers/reproduce_seed000.py [--out runs/seed000] [--seeds 5]

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reproduce seed 001 (static-base Kalman fine alignment) with the C++ firmware.
 The set-up is the built-in scenarios seed001_fine5 and seed001_fine8
-(pyins/scenarios/); this driver varies it by overrides (noise seed, correction
+(pyins/builtin/scenarios/); this driver varies it by overrides (noise seed, correction
 mode, ...) and adds the theoretical limits, the gaps, the figures and the
 measurements that explain the differences from the paper.
 

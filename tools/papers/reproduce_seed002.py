@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reproduce seed 002 (flexible two-position scheme under heading motion, 72 h).
 The set-up is the built-in scenarios seed002_exp1 and seed002_exp2
-(pyins/scenarios/); the error sets, the turn accelerations and the turns
+(pyins/builtin/scenarios/); the error sets, the turn accelerations and the turns
 summed are overrides of them. This driver adds the analysis and the report.
 
     .venv/bin/python tools/papers/reproduce_seed002.py [--out runs/seed002] [--hours 72]

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reproduce seed 003 (single-position forward/reverse rotate-stop, 24 h).
 The set-up (motion, sensor errors, the two schemes, the paper's bounds) is
-the built-in scenario seed003 (pyins/scenarios/seed003.toml); this driver
+the built-in scenario seed003 (pyins/builtin/scenarios/seed003.toml); this driver
 adds the error theory, the figures and the explanation.
 
     .venv/bin/python tools/papers/reproduce_seed003.py [--out runs/seed003] [--hours 24] [--seed 1]
