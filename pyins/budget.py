@@ -1,7 +1,7 @@
 """The error budget: each sensor error's share of a run's errors, driven by
 the run's history, and its check against the firmware in the loop.
 
-Issue 16. A constant drift is not the only error that survives a rotating
+A constant drift is not the only error that survives a rotating
 IMU: a scale-factor or misalignment error turns the IMU's own rate into a
 drift, eps^p(t) = (dK + M) omega_ip^p(t), and the accelerometers' into a
 bias, nabla^p(t) = (dK_a + M_a) f^p(t) (the sensor model of

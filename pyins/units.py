@@ -228,8 +228,3 @@ def _example(dimension):
             "velocity_random_walk": "5 ug/sqrt(Hz)", "length": "10 m", "velocity": "0.01 m/s",
             "angular_acceleration": "30 deg/s^2", "frequency": "0.2 Hz",
             "dimensionless": "10 ppm"}[dimension]
-
-
-def format_quantity(value_si, unit, dimension, digits=10):
-    """``value_si`` shown in ``unit`` (a unit of ``dimension``), e.g. "8.57 nmi"."""
-    return f"{value_si / UNITS[dimension][unit]:.{digits}g} {unit}".strip()

@@ -12,8 +12,8 @@
    NumPy plant + NumPy reference firmware; ticks per second and the ratios.
    The compiled plant's own cost is counted, not timed (3.).
 2. The full --hours run (default 72 h = 25.9 M ticks) through run_fil:
-   wall time and peak memory (issue 15's targets: < 6 s on a quiet machine,
-   < 500 MiB).
+   wall time and peak memory (the targets set for the closed loop: < 6 s on
+   a quiet machine, < 500 MiB).
 3. (``--count``, also at the end of the default run) the machine-independent
    cost: valgrind callgrind's instructions per tick inside pyins_fil_run
    (plant + firmware), of which inside pyins_run (the firmware; the plant is

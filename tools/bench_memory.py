@@ -1,6 +1,6 @@
 """Peak memory and wall time of ``pyins simulate`` and ``pyins replay`` against
-the length of the log (issue 14, defect 9): both stream in blocks, so their
-peak should not grow with the log.
+the length of the log (a long log was once held whole in memory): both
+stream in blocks, so their peak should not grow with the log.
 
 For each length (default 6 h and 24 h) it simulates a built-in scenario's
 log (``demo``, binary, as a subprocess), then replays it (``--scenario``, so

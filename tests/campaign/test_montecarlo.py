@@ -1,4 +1,5 @@
-"""Monte Carlo over the papers' random constants (issue 16): the draw is
+"""Monte Carlo over the papers' random constants (docs/campaigns.md, "Campaign
+files": random constants): the draw is
 N(0, sigma^2) per non-zero preset term with a fixed stream per draw; a
 campaign with ``random_constants`` gives every scheme of one draw the same
 constants (paired) and a new draw new ones; its mistakes are one line; the

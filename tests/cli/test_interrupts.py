@@ -1,6 +1,7 @@
-"""Ctrl-C, kill -9 and two writers, as a user meets them (issue 14 defects 5
-and 6): real signals to real ``python -m pyins`` processes. Ctrl-C stops a
-run or a campaign within seconds and leaves a summary ``pyins report``
+"""Ctrl-C, kill -9 and two writers, as a user meets them (docs/cli.md, "pyins
+run SCENARIO": Ctrl-C and kills, the lock, another scenario's directory):
+real signals to real ``python -m pyins`` processes. Ctrl-C stops a run or a
+campaign within seconds and leaves a summary ``pyins report``
 reads; after kill -9 the report reads what is there; a run directory being
 written is locked; a directory of another scenario is refused, never mixed.
 

@@ -1,4 +1,5 @@
-"""``pyins replay`` as a user with a field log meets it (issue 14): the rate
+"""``pyins replay`` as a user with a field log meets it (docs/cli.md, "pyins
+replay LOG"): the rate
 is the log's, an attitude nobody gave is refused, the firmware's limits are
 stated in the user's options, a log that ends mid-alignment says so."""
 import json

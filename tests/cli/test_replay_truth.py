@@ -1,5 +1,5 @@
-"""``pyins replay --truth FILE`` (issue 14, "where the user gives a reference
-(--truth FILE, ...) the errors against it"): a reference trajectory on the
+"""``pyins replay --truth FILE`` (docs/cli.md, "pyins replay LOG": where the
+user gives a reference, the errors against it): a reference trajectory on the
 log's clock, interpolated at the records, north/east and heading errors.
 
 The log is simulated (the demo ship: seed 002's heading swing, 6 deg/s at

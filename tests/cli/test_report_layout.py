@@ -1,4 +1,5 @@
-"""report.html and its figures read right (issue 14, defect 10): a stopped
+"""report.html and its figures read right (docs/cli.md, "pyins report
+RUNDIR"): a stopped
 run and a run shortened with ``--hours`` are labelled and not judged
 against the paper's full-length figures; the A_c/A_s panel only for a
 scheme that steers by the flexible sums; the position error split north /

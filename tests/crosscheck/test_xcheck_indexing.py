@@ -2,7 +2,7 @@
 on random schemes and ship-heading traces (hypothesis), with an ideal encoder
 (the table is where it was commanded one tick before).
 
-Properties (issue 4): stops last exactly their ticks; positions and
+Properties (docs/indexing.md, "The indexing machine"): stops last exactly their ticks; positions and
 directions follow the scheme; A_c, A_s change only while stopped (seed 002's
 rule, index_sums = stops) or on every tick, each time by the cos and sin of
 that tick's IMU heading (index_sums = all); a flexible turn starts braking on

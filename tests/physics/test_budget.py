@@ -94,7 +94,7 @@ def test_every_source_alone_and_their_sum(name, scheme):
     """Every source of the scenario's sensor set (gyro and accelerometer bias,
     scale factor, misalignment) and its initial errors, each alone through the
     firmware (6 h), and all together: the model within 10 % of each run's
-    largest horizontal error (issue 16's line; measured <= 0.05 %). A source
+    largest horizontal error (the budget's acceptance line; measured <= 0.05 %). A source
     whose run stays below 1 m (seed 002's uniform accelerometer scale factor acts
     along the held vertical only: exactly nothing horizontal) is held in
     absolute terms: within 0.1 m."""

@@ -1,4 +1,5 @@
-"""FIL runs checkpoint to disk and resume after being killed (issue 5).
+"""FIL runs checkpoint to disk and resume after being killed (docs/cli.md,
+"pyins run SCENARIO": checkpoints and --resume).
 
 A run with noise, indexing and alignment-free navigation is killed with
 SIGKILL in a subprocess once it has checkpointed, then resumed in this

@@ -1,6 +1,7 @@
 """A fine alignment that follows a coarse one starts from attitude sigmas that
-fit the coarse result (issue 14, defect 3; fine_align::sigma0_after_coarse,
-docs/core.md "Fine alignment after a coarse one").
+fit the coarse result, so that the heading does not swing when fine
+alignment begins (fine_align::sigma0_after_coarse, docs/core.md "Fine
+alignment after a coarse one").
 
 Before, it always started from seed 001's 100'/100'/600' whatever the coarse
 phase achieved: on a quiet simulated site (seed 001's errors) the heading,
@@ -51,10 +52,10 @@ def heading_excursion(out, fine, start):
 def test_the_heading_stays_at_the_coarse_value_when_fine_alignment_begins(states, method):
     """On the quiet site the coarse heading is right to ~3' (seed 001's
     limit 2.8' plus noise): the fine filter has nothing to correct by more
-    than a few times that. Bounds: 1 deg (issue 14's acceptance) and 3 x the
-    heading sigma the filter starts from (~10-20' here: a correct filter
-    does not move its estimate by more than a few sigmas). Before: 5.7-8.2
-    deg over these seeds (9.5 deg over 10)."""
+    than a few times that. Bounds: 1 deg (the bound the fix was accepted
+    on) and 3 x the heading sigma the filter starts from (~10-20' here: a
+    correct filter does not move its estimate by more than a few sigmas).
+    Before: 5.7-8.2 deg over these seeds (9.5 deg over 10)."""
     for seed in range(3):
         res, out, fine, start = coarse_then_fine(states, seed, 6000, method=method)
         exc = heading_excursion(out, fine, start)
@@ -153,9 +154,9 @@ def test_the_real_log_keeps_its_coarse_heading(tmp_path):
     fine, all defaults: the coarse phase measures ~840 ug/sqrt(Hz) of noise
     and vibration on the 0.1 s update interval (test_fine_noise.py), R is
     built from it, and the heading stays within 1 deg of the coarse value
-    (issue 14's acceptance; measured 0.04 deg; before: 162 deg with the old
-    600' start, 6.5-10.6 deg with the fitted start and R from the default
-    10 ug/sqrt(Hz), ALIGN_INCONSISTENT set). The measurements then fit the
+    (the bound the fix was accepted on; measured 0.04 deg; before: 162 deg
+    with the old 600' start, 6.5-10.6 deg with the fitted start and R from
+    the default 10 ug/sqrt(Hz), ALIGN_INCONSISTENT set). The measurements then fit the
     model: the last NIS window's mean is below the firmware's bound 4 (with
     the default R it was ~7800) and above 0.5 (R at most ~4x the innovations'
     variance; measured 1.1: the noise of the first 120 s, measured

@@ -1,8 +1,9 @@
-"""The fine alignment's measurement noise from the coarse phase (issue 14,
-defect 3 on real data): the coarse phase measures the horizontal specific-
-force noise on the fine filter's update interval (coarse_align.hpp,
-"Noise"), and the static fine filters build R from it when it is larger
-than the configured density (fine_noise MEASURED, the default).
+"""The fine alignment's measurement noise from the coarse phase (so that
+the heading does not swing when fine alignment begins on real data): the
+coarse phase measures the horizontal specific-force noise on the fine filter's
+update interval (coarse_align.hpp, "Noise"), and the static fine filters
+build R from it when it is larger than the configured density (fine_noise
+MEASURED, the default).
 
 Before, R came from the configured 10 ug/sqrt(Hz) whatever the site: on the
 real PSINS laser-gyro log of a parked vehicle (~800 ug/sqrt(Hz) of noise and

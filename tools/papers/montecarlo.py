@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Monte Carlo over the papers' random constants (issue 16): seeds 002 and 003.
+"""Monte Carlo over the papers' random constants (docs/campaigns.md, "Campaign
+files": random constants): seeds 002 and 003.
 
     .venv/bin/python tools/papers/montecarlo.py [seed002] [seed003] [--draws 100] [--block 10]
         [--out runs/montecarlo] [--workers 2] [--scheduler tcp://HOST:8786] [--report docs/results]
