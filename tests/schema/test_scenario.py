@@ -21,7 +21,8 @@ ROOT = Path(__file__).resolve().parents[2]
 DEG = units.DEG_TO_RAD
 BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001_fine8",
             "seed002_exp1", "seed002_exp2", "seed003",
-            "moored_bad", "moored_general", "moored_ideal", "moored_spectrum"]   # test_scenario_ship.py
+            "moored_bad", "moored_general", "moored_ideal", "moored_spectrum",   # test_scenario_ship.py
+            "harbour_ranging"]                                                  # test_harbour_ranging.py
 
 
 def _tool(name):
