@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from pyins import (__version__, bench, budget, campaign, engine, logs, metrics, native, open_loop, replay,
+from pyins import (__version__, bench, budget, campaign, contract, engine, logs, metrics, open_loop, replay,
                    replay_options, report, run_scenario, rundir, scenario, sim, truth_track)
 from pyins.progress import Phases, TextProgress, phase
 from pyins.report.paper import paper_rows
@@ -67,7 +67,7 @@ def _demo(args):
         "max_level_error_arcsec": float(np.abs(e.att_n_rad[:, :2]).max() / arcsec),
         "max_heading_error_arcmin": float(np.abs(e.att_n_rad[:, 2]).max() / arcmin),
         "max_velocity_error_mps": float(np.abs(e.vel_n_mps[:, :2]).max()),
-        "core_version": native.version(),
+        "core_version": engine.core_version(),
     }
     os.makedirs(args.out, exist_ok=True)
     th = e.time_s / 3600.0
@@ -599,7 +599,7 @@ def main(argv=None):
                 ap.error("--hours: must be positive")
             return _demo(args)
         if args.command == "version":
-            print(f"pyins {__version__}, core {native.version()} (ABI {'.'.join(map(str, native.abi_version()))})")
+            print(f"pyins {__version__}, core {engine.core_version()}" + (f" (ABI {engine.core_abi()})" if engine.core_abi() else ""))
             return EXIT_OK
         return handlers[args.command](args)
     except KeyboardInterrupt:
@@ -614,7 +614,7 @@ def main(argv=None):
     except Exception as exc:   # one line for the user; --debug for the traceback
         if args.debug:
             raise
-        if isinstance(exc, native.CoreError):
+        if isinstance(exc, contract.CoreError):
             print(f"pyins {args.command}: firmware error: {exc}", file=sys.stderr)
             return EXIT_FAILED
         if isinstance(exc, (InputError, ValueError, OSError, ImportError)):

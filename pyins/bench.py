@@ -10,7 +10,7 @@ Three figures on this machine, each timed for about ``seconds``:
 """
 import time
 
-from pyins import engine, fil, native, scenario, sim
+from pyins import contract, engine, fil, scenario, sim
 from pyins.units import DT
 
 
@@ -32,11 +32,11 @@ def run(seconds=3.0):
     n = 100_000
     dth, dv, al = sim.exact_increments(m, n)
     dth, dv = sim.SensorModel(errors, seed=1).apply(dth, dv)
-    samples = native.make_samples(dth, dv, al)
+    samples = contract.make_samples(dth, dv, al)
     cfg = scenario.initial_config(m, None)
 
     def cpp():
-        native.Firmware(cfg).run(samples, every=100)
+        engine.firmware("native", cfg).run(samples, every=100)
     calls, wall = _timed(cpp, seconds)
     cpp_rate = calls * n / wall
 
@@ -57,7 +57,7 @@ def run(seconds=3.0):
     fil_rate = calls * f_ticks / wall
     return {"cpp_firmware_ticks_per_s": cpp_rate, "numpy_reference_ticks_per_s": ref_rate,
             "ratio_cpp_over_numpy": cpp_rate / ref_rate, "fil_closed_loop_ticks_per_s": fil_rate,
-            "fil_ship_hours_per_wall_s": fil_rate * DT / 3600.0, "core_version": native.version()}
+            "fil_ship_hours_per_wall_s": fil_rate * DT / 3600.0, "core_version": engine.core_version()}
 
 
 def lines(fig):

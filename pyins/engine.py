@@ -7,7 +7,7 @@ the NumPy mirror of the core (`pyins.reference.Firmware`, the same
 constructor, ``step``, ``run``, ``snapshot``/``restore`` and records of
 ``native.OUTPUT_DTYPE``) and the NumPy mirror of the plant (`MirrorPlant`,
 over `pyins.sim.turntable`), about a thousand times slower. Everything above
-(runner, fil, runs, the CLI's ``--engine``) is the same code for both.
+(open_loop, fil, run_scenario, the CLI's ``--engine``) is the same code for both.
 
 The reference engine needs no compiled library: `pyins.native` is imported
 here once at module level, and a failure (no library built, a stale one) is
@@ -37,6 +37,19 @@ def native_error():
     """None when the native engine is available, else why it is not (the
     ImportError's message of `pyins.native`)."""
     return _NATIVE_ERROR
+
+
+def core_version():
+    """The compiled core's version string (what run summaries record), or
+    what stands in its place when the library is not there."""
+    if native is None:
+        return "none (no compiled library: the reference engine only)"
+    return native.version()
+
+
+def core_abi():
+    """The compiled core's ABI as "major.minor", or None without the library."""
+    return None if native is None else ".".join(map(str, native.abi_version()))
 
 
 def check(engine):

@@ -29,7 +29,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from pyins import engine as engines
-from pyins import native, records, sim
+from pyins import contract, records, sim
 from pyins.records import CHECKPOINT, PLANT_RECORD_DTYPE, FilResult, load_records
 from pyins.scenario.build import initial_config
 from pyins.sim.turntable import TableConfig, error_matrices
@@ -125,7 +125,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     if checkpoint_ticks is not None and checkpoint_ticks <= 0:
         raise ValueError(f"run_fil: checkpoint_ticks must be > 0, got {checkpoint_ticks}")
     engines.check(engine)
-    if engine == "native" and native.plant is None:
+    if engine == "native" and engines.native is not None and engines.native.plant is None:
         raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
 
     # 1. the loop's parts
@@ -174,7 +174,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             try:
                 out, rec = loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise,
                                           n, dt, every)
-            except native.PlantError as exc:         # keep what was done before the rejected sample
+            except contract.PlantError as exc:         # keep what was done before the rejected sample
                 if sink is not None:
                     sink.write(exc.outputs, exc.records)
                     sink.close()
@@ -212,7 +212,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
         outputs, plant, _ = load_records(record_dir)
     else:
-        outputs = outs[:kept] if outs is not None else np.empty(0, dtype=native.OUTPUT_DTYPE)
+        outputs = outs[:kept] if outs is not None else np.empty(0, dtype=contract.OUTPUT_DTYPE)
         plant = recs[:kept] if recs is not None else np.empty(0, dtype=PLANT_RECORD_DTYPE)
     truth = sim.truth_at(motion, np.asarray(outputs["tick"]), dt=dt)
     return FilResult(outputs=outputs, plant=plant, truth=truth, dt=dt)

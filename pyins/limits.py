@@ -14,7 +14,8 @@ limits are not written a second time here.
 """
 import math
 
-from pyins import native
+from pyins import contract
+from pyins import engine as engines
 from pyins.reference import abi, coarse_align
 from pyins.reference import config as fw_config
 from pyins.units import DEG_TO_RAD
@@ -95,12 +96,12 @@ def explain(status, cfg, names=None):
                 "be positive and finite")
     if status == abi.PYINS_E_CONFIG_COARSE_METHOD:
         return f"{n('coarse_method')}: triad, fit or eq8"
-    return f"the firmware refuses the configuration: {native.status_str(status)}"
+    return f"the firmware refuses the configuration: {contract.status_str(status)}"
 
 
 def check(cfg, names=None):
     """None when the core accepts ``cfg``, else (status, sentence)."""
-    status = native.lib.pyins_config_check(native.make_config(cfg))
+    status = engines.config_check(cfg)
     if status == 0:
         return None
     return status, explain(status, cfg, names)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyins import engine as engines
-from pyins import native, sim
+from pyins import contract, sim
 from pyins.scenario.build import initial_config
 from pyins.units import DT
 
@@ -45,10 +45,10 @@ def navigate(motion, duration_ticks, every=100, sensors=None, table=None, config
                               sensors=sensors, with_truth=False):
         # seq: the tick number each sample ends, as an IMU's packet counter
         # (read only when the configuration sets seq_mode = 1)
-        samples = native.make_samples(chunk.dtheta_p, chunk.dv_p, chunk.table_angle, seq=chunk.tick)
+        samples = contract.make_samples(chunk.dtheta_p, chunk.dv_p, chunk.table_angle, seq=chunk.tick)
         outs.append(fw.run(samples, every=every))
         if progress is not None:
             progress(int(chunk.tick[-1]), duration_ticks)
-    outputs = np.concatenate(outs) if outs else np.zeros(0, dtype=native.OUTPUT_DTYPE)
+    outputs = np.concatenate(outs) if outs else np.zeros(0, dtype=contract.OUTPUT_DTYPE)
     truth = sim.truth_at(motion, outputs["tick"], dt=dt, table=table)
     return RunResult(outputs=outputs, truth=truth, dt=dt)

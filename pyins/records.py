@@ -2,7 +2,7 @@
 
 A record directory (``fil.run_fil(record_dir=...)``) holds::
 
-    outputs.bin       the firmware's decimated records, raw native.OUTPUT_DTYPE
+    outputs.bin       the firmware's decimated records, raw contract.OUTPUT_DTYPE
     plant.bin         the plant's at the same ticks, raw PLANT_RECORD_DTYPE
     records.json      what the two files hold: dtypes, interval, ticks done
     checkpoint.json   the last checkpoint (firmware, plant, noise generator)
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyins import metrics, native, sim
+from pyins import contract, metrics, sim
 from pyins.units import ARCSEC_TO_RAD
 
 #: The plant's record at each kept tick: true table angle, rate, encoder.
@@ -42,7 +42,7 @@ RECORDS = "records.json"
 CHECKPOINT = "checkpoint.json"
 CHECKPOINT_VERSION = 1
 CSV_MAX_ROWS = 20_000
-_SINKS = (("outputs.bin", native.OUTPUT_DTYPE), ("plant.bin", PLANT_RECORD_DTYPE))
+_SINKS = (("outputs.bin", contract.OUTPUT_DTYPE), ("plant.bin", PLANT_RECORD_DTYPE))
 
 
 @dataclass
@@ -214,7 +214,7 @@ def lock_dir(directory, what="run directory", notice=None):
 def write_records_json(record_dir, every, dt, duration_ticks, done):
     """records.json: the dtypes of the two files and how far the run got."""
     write_atomic(os.path.join(record_dir, RECORDS), json.dumps(
-        {"outputs.bin": str(native.OUTPUT_DTYPE.descr), "plant.bin": str(PLANT_RECORD_DTYPE.descr),
+        {"outputs.bin": str(contract.OUTPUT_DTYPE.descr), "plant.bin": str(PLANT_RECORD_DTYPE.descr),
          "every_ticks": every, "dt_s": dt, "ticks": int(duration_ticks), "ticks_done": int(done),
          "complete": bool(done >= duration_ticks)}, indent=2))
 

@@ -29,7 +29,7 @@ import os
 import numpy as np
 
 from pyins import engine as engines
-from pyins import logs, metrics, native, open_loop, records, scenario, sim
+from pyins import contract, logs, metrics, open_loop, records, scenario, sim
 from pyins.reference import abi
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
@@ -257,7 +257,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     try:
         try:
             for piece in _blocks(data, block):
-                chunk = native.make_samples(piece.dtheta_p, piece.dv_p, piece.table_angle_rad)
+                chunk = contract.make_samples(piece.dtheta_p, piece.dv_p, piece.table_angle_rad)
                 recs = fw.run(chunk, every=every)
                 samples += len(chunk)
                 if len(recs):

@@ -22,7 +22,8 @@ import shutil
 import time
 
 from pyins import engine as engines
-from pyins import fil, metrics, native, records
+from pyins import engine as engines
+from pyins import fil, metrics, records
 from pyins.metrics import group_metrics
 from pyins.progress import phase
 from pyins.rundir import (check_run_dir, hold_interrupts, load_variant, slug, variant_facts, write_summary,
@@ -98,7 +99,7 @@ def _start(scn, run_dir, resume, engine, force):
     specs = list(scn.runs())
     written = written_durations(scn)
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
-                   digest=scn.digest(), core_version=native.version(), paper=scn.paper,
+                   digest=scn.digest(), core_version=engines.core_version(), paper=scn.paper,
                    variants=[_entry(spec, written) for spec in specs], complete=False, state="running",
                    scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name))
     if engine != "native":

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyins import limits, native, sim
+from pyins import contract, limits, sim
+from pyins import engine as engines
 from pyins.reference import attitude, earth
 from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, FINE_NOISES, INDEX_SUMS, VERTICAL_MODES,
                                    _LINEAR_AXES, _STEP_MOVES, _TABLE_FAULTS)
@@ -264,10 +265,10 @@ def _firmware_check(motion, cfg):
     """The firmware's own check (pyins_config_check) of the configuration a
     run of ``motion`` with the overrides ``cfg`` hands it."""
     full = initial_config(motion, None, **cfg)
-    status = native.lib.pyins_config_check(native.make_config(full))
+    status = engines.config_check(full)
     if status != 0:
-        name = native.status_str(status).split(":")[0]
-        raise ScenarioError(f"the firmware refuses the configuration: {native.status_str(status)} "
+        name = contract.status_str(status).split(":")[0]
+        raise ScenarioError(f"the firmware refuses the configuration: {contract.status_str(status)} "
                             f"({limits.explain(status, full, _FIELD_KEYS)})",
                             _STATUS_KEYS.get(name, "firmware"))
 

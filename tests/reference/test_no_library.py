@@ -10,6 +10,7 @@ the venv's site-packages (NumPy, cffi): ``pyins`` is the copy, importing
 those of the same run in this process, bit for bit: the reference engine
 reads nothing from the library (its defaults included).
 """
+import json
 import os
 import shutil
 import subprocess
@@ -22,7 +23,7 @@ import numpy as np
 import pytest
 
 import pyins
-from pyins import contract, engine, sim
+from pyins import contract, engine, fil, scenario, sim
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE = next(Path(p) for p in pyins.__path__ if (Path(p) / "__init__.py").is_file())
@@ -134,20 +135,34 @@ def _blocking_chain(stderr):
 
 def test_a_builtin_scenario_runs_on_the_reference_engine_without_the_library(no_library, tmp_path):
     """300 ticks of the built-in 'demo' through pyins.fil.run_fil(engine='reference')
-    (the closed loop over the NumPy plant, what a scenario run calls). Expected to fail while the
-    scenario's build imports pyins.native for the firmware's configuration
-    check (pyins/scenario/build.py, pyins/limits.py: pyins_config_check);
-    the xfail names the chain it met."""
+    (the closed loop over the NumPy plant, what a scenario run calls): the
+    scenario's build checks the configuration with the reference's mirror
+    of pyins_config_check (engine.config_check), and the records are those
+    of the same run here, bit for bit."""
     run, _ = no_library
     out = tmp_path / "records.npy"
     proc = run(RUN_SCENARIO, str(out))
-    if proc.returncode != 0 and "libpyins_core.so was not found" in proc.stderr:
-        pytest.xfail("a module on the run path imports pyins.native: " + _blocking_chain(proc.stderr))
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == 0, "a module on the run path needs the library: " + _blocking_chain(proc.stderr)
     away = np.load(out)
-    # here, not at the top: the scenario path is this test's alone (and in flux)
-    from pyins import fil, scenario   # noqa: PLC0415
     spec = next(iter(scenario.load("demo").runs()))
     here = fil.run_fil(spec.motion, 300, config=spec.config, errors=spec.errors, seed=spec.seed,
                        table=spec.table, every=100, dt=spec.dt, engine="reference").outputs
     assert away.shape == (3,) and away.tobytes() == here.tobytes()
+
+
+def test_the_cli_runs_a_builtin_scenario_on_the_reference_engine_without_the_library(no_library, tmp_path):
+    """`pyins run demo --engine reference` as a user without a build runs it:
+    exit 0, a summary that says no compiled core was there; `pyins version`
+    says the same; the native engine is refused with the loader's reason."""
+    run, _ = no_library
+    out = tmp_path / "demo"
+    proc = run("import sys; from pyins.__main__ import main; sys.exit(main(sys.argv[1:]))",
+               "run", "demo", "--engine", "reference", "--hours", "0.001", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["core_version"].startswith("none (no compiled library")
+    proc = run("import sys; from pyins.__main__ import main; sys.exit(main(sys.argv[1:]))", "version")
+    assert proc.returncode == 0 and "core none (no compiled library" in proc.stdout, proc.stdout + proc.stderr
+    proc = run("import sys; from pyins.__main__ import main; sys.exit(main(sys.argv[1:]))",
+               "run", "demo", "--hours", "0.001", "--out", str(tmp_path / "native"))
+    assert proc.returncode != 0 and "engine 'native' is not available" in proc.stderr, proc.stderr
