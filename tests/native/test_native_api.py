@@ -102,7 +102,7 @@ def test_wrong_arrays_raise_value_error_naming_the_field(field):
     with pytest.raises(ValueError, match=f"{field}: shape"):
         native.make_samples(**wrong_shape)
     # a view (every other row, a column slice of a log) is copied, not refused:
-    # the documented path make_samples(d.dtheta_p, ...) gets such views (issue 14)
+    # the documented path make_samples(d.dtheta_p, ...) gets such views (a log read by pyins.logs)
     big = np.random.default_rng(1).normal(size=(2 * n, 3) if good[field].ndim == 2 else 2 * n)
     view = dict(good, **{field: big[::2]})
     copy = dict(good, **{field: np.ascontiguousarray(big[::2])})

@@ -47,7 +47,7 @@ def test_golden_records(name):
 def test_compact_records_are_the_full_records_fields(name):
     """pyins_run_nav's record is pyins_output's fields of the same names,
     bit for bit, on every tick of every case: each mode, scheme, lever arm
-    and sample fault (issue 15: the compact record must not be a second
+    and sample fault (the compact record must not be a second
     navigation solution)."""
     d = np.load(os.path.join(DATA, f"{name}.npz"))
     cfg = json.loads(str(d["config"]))
