@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 13
+#define PYINS_ABI_VERSION_MINOR 14
 
 #ifdef __cplusplus
 extern "C" {
@@ -278,6 +278,11 @@ typedef struct pyins_config {
     /* The moving-base fine alignment (fine_states = 12). */
     double fine_pos_sigma_m;      /* R: the waves' horizontal displacement [m]; 0 = 0.5 m */
     double fine_sigma0_vel_mps;   /* initial sigma of the velocity error [m/s]; 0 = 0.5 m/s */
+    double fine_site_accel;       /* the site's slow horizontal motion (a ship ranging on its lines):
+                                     white acceleration density [m/s^2/sqrt(Hz)], its displacement an
+                                     integrated random walk in the filter's Q and in the prior it
+                                     takes from the coarse result (moving_align.hpp); >= 0,
+                                     0 = a rigid site */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */

@@ -71,6 +71,7 @@ typedef struct pyins_t_moving_params {
     double gyro_arw, accel_vrw, pos_sigma;
     double sigma0_att[3];
     double sigma0_vel, sigma0_gyro, sigma0_accel, nis_max;
+    double site_accel;
 } pyins_t_moving_params;
 
 /* coarse_align (moving base) */
@@ -88,6 +89,9 @@ void pyins_t_coarse_solve_eq8(const double vi1[3], const double vi2[3], const do
  * updates, and the last window mean NIS in *nis_mean. */
 int pyins_t_moving_align_run(const pyins_t_moving_params *p, const double *dv_sf_n, const double *z,
                              size_t n, double *x_out, double *p_out, double *nis_mean);
+/* moving_align::sigma0_after_coarse on p's sigma0_att: writes the result */
+void pyins_t_moving_sigma0_after_coarse(const pyins_t_moving_params *p, double coarse_s, double wander,
+                                        double gravity, double sigma0_att_out[3]);
 
 /* math_portable */
 double pyins_t_sin(double x);

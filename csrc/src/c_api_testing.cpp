@@ -226,8 +226,8 @@ double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]) {
     return pyins::coarse_align::rotation_sine(m9(a), m9(b));
 }
 
-int pyins_t_moving_align_run(const pyins_t_moving_params* p, const double* dv_sf_n, const double* z,
-                             size_t n, double* x_out, double* p_out, double* nis_mean) {
+namespace {
+pyins::moving_align::Params moving_params(const pyins_t_moving_params* p) {
     pyins::moving_align::Params prm;
     prm.sin_lat = p->sin_lat;
     prm.cos_lat = p->cos_lat;
@@ -246,6 +246,23 @@ int pyins_t_moving_align_run(const pyins_t_moving_params* p, const double* dv_sf
     prm.sigma0_accel = p->sigma0_accel;
     prm.nis_window = p->nis_window;
     prm.nis_max = p->nis_max;
+    prm.site_accel = p->site_accel;
+    return prm;
+}
+}  // namespace
+
+void pyins_t_moving_sigma0_after_coarse(const pyins_t_moving_params* p, double coarse_s, double wander,
+                                        double gravity, double sigma0_att_out[3]) {
+    pyins::moving_align::Params prm = moving_params(p);
+    pyins::moving_align::sigma0_after_coarse(prm, coarse_s, wander, gravity);
+    sigma0_att_out[0] = prm.sigma0_att[0];
+    sigma0_att_out[1] = prm.sigma0_att[1];
+    sigma0_att_out[2] = prm.sigma0_att[2];
+}
+
+int pyins_t_moving_align_run(const pyins_t_moving_params* p, const double* dv_sf_n, const double* z,
+                             size_t n, double* x_out, double* p_out, double* nis_mean) {
+    const pyins::moving_align::Params prm = moving_params(p);
     pyins::moving_align::MovingAlign m;
     pyins::moving_align::init(m, prm);
     int updates = 0;

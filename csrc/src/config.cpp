@@ -226,6 +226,10 @@ int config_check(const pyins_config& raw) {
             return PYINS_E_CONFIG_NOISE;
         }
     }
+    // the site's slow motion: 0 (a rigid site) or a finite density
+    if (!(cfg.fine_site_accel >= 0.0) || !std::isfinite(cfg.fine_site_accel)) {
+        return PYINS_E_CONFIG_NOISE;
+    }
     const int index_status = index_check(cfg);
     if (index_status != PYINS_OK) {
         return index_status;

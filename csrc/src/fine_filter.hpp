@@ -44,6 +44,7 @@ struct Params {
     double rn_h;             ///< R_N + h at the site [m]
     double pos_sigma;        ///< R: the waves' horizontal displacement [m]
     double sigma0_vel;       ///< [m/s]
+    double site_accel;       ///< the site's slow motion [m/s^2/sqrt(Hz)]; 0: rigid (moving_align.hpp)
 };
 
 /// What a coarse alignment leaves the static-base filters.
@@ -165,7 +166,9 @@ class FineFilter {
     /// coarse_align.hpp, "Noise") and fit each attitude sigma left 0 to the
     /// coarse result (fine_align::sigma0_after_coarse, capped at the
     /// default). The moving-base filter keeps the configured values (its
-    /// default attitude sigma is already the fit, with margin: config.hpp).
+    /// default attitude sigma is already the fit, with margin: config.hpp)
+    /// and, when the site moves (site_accel > 0), adds what the site motion
+    /// and the wander leave the coarse result (moving_align::sigma0_after_coarse).
     void init(int32_t states, const Params& prm, const AfterCoarse* after_coarse) {
         states_ = states;
         vrw_ = 0.0;
@@ -181,6 +184,7 @@ class FineFilter {
             mp.gyro_arw = base.gyro_arw;
             mp.accel_vrw = base.accel_vrw;
             mp.pos_sigma = prm.pos_sigma;
+            mp.site_accel = prm.site_accel;
             mp.sigma0_att[0] = base.sigma0_att[0];
             mp.sigma0_att[1] = base.sigma0_att[1];
             mp.sigma0_att[2] = base.sigma0_att[2];
@@ -189,6 +193,9 @@ class FineFilter {
             mp.sigma0_accel = base.sigma0_accel;
             mp.nis_window = base.nis_window;
             mp.nis_max = base.nis_max;
+            if (after_coarse != nullptr) {
+                moving_align::sigma0_after_coarse(mp, after_coarse->seconds, after_coarse->wander, base.gravity);
+            }
             moving_align::init(moving_, mp);
             return;
         }

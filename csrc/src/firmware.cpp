@@ -361,6 +361,7 @@ void Firmware::start_fine() {
     prm.rn_h = r.rn + cfg_.height_m;
     prm.pos_sigma = cfg_.fine_pos_sigma_m;
     prm.sigma0_vel = cfg_.fine_sigma0_vel_mps;
+    prm.site_accel = cfg_.fine_site_accel;
     // what the coarse phase measured (fine_filter.hpp says what each filter takes)
     fine_filter::AfterCoarse after_coarse;
     if (cfg_.coarse_ticks > 0) {

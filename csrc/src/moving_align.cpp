@@ -2,6 +2,7 @@
 #include "moving_align.hpp"
 
 #include "earth.hpp"
+#include "math_portable.hpp"
 
 namespace pyins::moving_align {
 
@@ -35,6 +36,22 @@ void init(MovingAlign& m, const Params& prm) {
     m.nis_count = 0;
     m.nis_mean = 0.0;
     m.nis_windows = 0;
+}
+
+void sigma0_after_coarse(Params& prm, double coarse_s, double wander, double gravity) {
+    if (!(prm.site_accel > 0.0)) {
+        return;
+    }
+    // header: the level q / (g sqrt(T)), the heading q / (k sqrt(3 T^3)), k = g w_N / 6
+    const double k = gravity * earth::kOmegaIe * prm.cos_lat / 6.0;
+    const double level = prm.site_accel / (gravity * pmath::sqrt(coarse_s));
+    const double heading = prm.site_accel / (k * pmath::sqrt(3.0 * coarse_s * coarse_s * coarse_s));
+    const double w2 = wander * wander;
+    const double add[3] = {level * level + w2, level * level + w2, heading * heading + w2};
+    for (int i = 0; i < 3; ++i) {
+        const double s = prm.sigma0_att[i];
+        prm.sigma0_att[i] = pmath::sqrt(s * s + kSiteMargin * kSiteMargin * add[i]);
+    }
 }
 
 M12 system_matrix(const Params& prm, const Vec3& f_n) {
@@ -84,7 +101,8 @@ bool step(MovingAlign& m, const Vec3& dv_sf_n, const double z_en[2]) {
         phi(i, i) = phi(i, i) + 1.0;
     }
     // Time update: x = Phi x, P = Phi P Phi^T + Qd (Qd diagonal:
-    // arw^2 T on phi, vrw^2 T on dv), symmetrised.
+    // arw^2 T on phi, (vrw^2 + site_accel^2) T on dv: the site's slow
+    // motion, header), symmetrised.
     {
         // lazyProduct evaluates straight into its destination: never alias
         const kalman::Vec<kStates> xp = phi.lazyProduct(m.x);
@@ -95,7 +113,7 @@ bool step(MovingAlign& m, const Vec3& dv_sf_n, const double z_en[2]) {
         m.p = ap.lazyProduct(phi.transpose());
     }
     const double q_att = m.prm.gyro_arw * m.prm.gyro_arw * span;
-    const double q_vel = m.prm.accel_vrw * m.prm.accel_vrw * span;
+    const double q_vel = (m.prm.accel_vrw * m.prm.accel_vrw + m.prm.site_accel * m.prm.site_accel) * span;
     m.p(kPhi + 0, kPhi + 0) = m.p(kPhi + 0, kPhi + 0) + q_att;
     m.p(kPhi + 1, kPhi + 1) = m.p(kPhi + 1, kPhi + 1) + q_att;
     m.p(kPhi + 2, kPhi + 2) = m.p(kPhi + 2, kPhi + 2) + q_att;

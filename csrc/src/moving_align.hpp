@@ -32,6 +32,30 @@
 // (H a unit row, R diagonal). Feedback after every update (the
 // firmware corrects attitude, velocity and position and zeroes phi, dv, dp).
 // Integrity: the same NIS windows as fine_align.
+//
+// The site's slow motion (site_accel; docs/concepts.md, "What integrity
+// catches and what it cannot"). A ship ranging on its lines moves the
+// reference point by metres at periods of minutes: in z that is not white
+// noise but a smooth displacement d, and the filter reads heading from the
+// cubic p_N = -(1/6) g w_N phi_U t^3 (1' is 3.2 m over 480 s), so d of a
+// period near the alignment's length becomes arc-minutes of heading that
+// the filter, taking d as white, reports with a sigma of ~3'. Modelled:
+// d'' = white acceleration of density q = site_accel (an integrated random
+// walk). The filter's position and velocity states then stand for the
+// reference point's offset from the site, dp + d, dv + d', whose dynamics
+// are dp's plus that acceleration: Qd on dv gains q^2 T (the same model as
+// two more states for d, with d absorbed into dp, dv: no new state; the
+// feedback then moves the navigation to the site's mean, by up to the
+// ranging's amplitude). The heading's information from position over T
+// against that acceleration, the t^2 term free (tilt, bias): the second
+// derivative of the signal, 6 k phi_U (t - T/2), k = g w_N / 6, whitened by q,
+// integrates to 3 k^2 T^3 / q^2 (Fisher information of the t^3 coefficient,
+// e.g. Bar-Shalom et al. 2001, sec. 2.7.2); so a coarse alignment of T_c
+// seconds leaves phi_U a sigma of at least q / (k sqrt(3 T_c^3)) and the
+// level q / (g sqrt(T_c)) (the constant acceleration's). sigma0_after_coarse
+// adds these (and the coarse wander) to the prior, kSiteMargin times, in
+// quadrature: 120 s of FIT and q = 1000 ug/sqrt(Hz) give 150' of heading.
+// With q = 0 (a rigid site: the default) nothing changes, bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -48,6 +72,9 @@ inline constexpr int kVel = 3;    ///< dv_E, dv_N
 inline constexpr int kPos = 5;    ///< dp_E, dp_N
 inline constexpr int kEps = 7;    ///< eps_E, eps_N, eps_U
 inline constexpr int kNabla = 10; ///< nabla_E, nabla_N
+/// The prior's margin on what the site motion and the wander leave the
+/// coarse result (fine_align::kAfterCoarseMargin's 3, for the same reason).
+inline constexpr double kSiteMargin = 3.0;
 
 struct Params {
     double sin_lat;
@@ -59,6 +86,7 @@ struct Params {
     double gyro_arw;         ///< [rad/sqrt(s)]
     double accel_vrw;        ///< [(m/s)/sqrt(s)]
     double pos_sigma;        ///< R: the waves' horizontal displacement [m]
+    double site_accel;       ///< the site's slow motion: white acceleration density [m/s^2/sqrt(Hz)]; 0: rigid
     double sigma0_att[3];    ///< [rad]
     double sigma0_vel;       ///< [m/s]
     double sigma0_gyro;      ///< [rad/s]
@@ -82,6 +110,12 @@ struct MovingAlign {
 };
 
 void init(MovingAlign& m, const Params& prm);
+
+/// After a coarse alignment of coarse_s seconds that wandered by `wander`
+/// (sine): sigma0_att[i] = sqrt(sigma0_att[i]^2 + kSiteMargin^2 (s_i^2 +
+/// wander^2)), s = the site motion's level and heading sigmas (header);
+/// nothing when site_accel is 0. gravity [m/s^2] at the site.
+void sigma0_after_coarse(Params& prm, double coarse_s, double wander, double gravity);
 
 /// Continuous-time F for the mean specific force f_n [m/s^2].
 kalman::Mat<kStates, kStates> system_matrix(const Params& prm, const Vec3& f_n);

@@ -109,6 +109,7 @@ def config_default():
         "integrity_coarse_rad": 0.0,
         "fine_pos_sigma_m": 0.0,
         "fine_sigma0_vel_mps": 0.0,
+        "fine_site_accel": 0.0,
     }
 
 
@@ -260,6 +261,9 @@ def config_check(raw):
     for v in noise:
         if not (v > 0.0) or not math.isfinite(v):
             return abi.PYINS_E_CONFIG_NOISE
+    # the site's slow motion: 0 (a rigid site) or a finite density
+    if not (cfg["fine_site_accel"] >= 0.0) or not math.isfinite(cfg["fine_site_accel"]):
+        return abi.PYINS_E_CONFIG_NOISE
     index_status = index_check(cfg)
     if index_status != abi.PYINS_OK:
         return index_status

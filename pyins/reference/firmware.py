@@ -293,9 +293,13 @@ class Firmware:
                 sin_lat=sin_lat, cos_lat=cos_lat, rm_h=rm + cfg["height_m"], rn_h=rn + cfg["height_m"],
                 dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
                 accel_vrw=cfg["fine_accel_vrw"], pos_sigma=cfg["fine_pos_sigma_m"],
+                site_accel=cfg["fine_site_accel"],
                 sigma0_att=np.array(cfg["fine_sigma0_att_rad"], dtype=float),
                 sigma0_vel=cfg["fine_sigma0_vel_mps"], sigma0_gyro=cfg["fine_sigma0_gyro"],
                 sigma0_accel=cfg["fine_sigma0_accel"], nis_window=prm.nis_window, nis_max=prm.nis_max)
+            if cfg["coarse_ticks"] > 0:
+                moving_align.sigma0_after_coarse(mp, float(cfg["coarse_ticks"]) * self.dt, self.coarse.wander,
+                                                 prm.gravity)
         if self.has_lever:
             self.lever_vel_n = attitude.quat_to_mat(self.sd.nav.quat_np) @ self.lever_vel_p()
         self.fine = moving_align.init(mp) if self.kf_states == 12 else fine_align.init(self.kf_states, prm)

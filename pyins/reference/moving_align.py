@@ -5,6 +5,7 @@ Mirrors ``csrc/src/moving_align.{hpp,cpp}``; the header gives the model
 measurement (the reference point's offset from the site, the waves as its
 noise) and the discretisation.
 """
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,6 +18,7 @@ VEL = 3           #: kVel
 POS = 5           #: kPos
 EPS = 7           #: kEps
 NABLA = 10        #: kNabla
+SITE_MARGIN = 3.0  #: kSiteMargin
 
 
 @dataclass
@@ -30,6 +32,7 @@ class Params:
     gyro_arw: float
     accel_vrw: float
     pos_sigma: float
+    site_accel: float
     sigma0_att: np.ndarray
     sigma0_vel: float
     sigma0_gyro: float
@@ -59,6 +62,23 @@ def init(prm):
                       prm.pos_sigma, prm.sigma0_gyro, prm.sigma0_gyro, prm.sigma0_gyro,
                       prm.sigma0_accel, prm.sigma0_accel])
     return MovingAlign(prm=prm, p=np.diag(sigma * sigma))
+
+
+def sigma0_after_coarse(prm, coarse_s, wander, gravity):
+    """Add what the site's slow motion and the wander leave a coarse result of coarse_s seconds
+    to prm.sigma0_att, in quadrature (mirrors sigma0_after_coarse; the header derives it)."""
+    if not prm.site_accel > 0.0:
+        return
+    k = gravity * earth.OMEGA_IE * prm.cos_lat / 6.0
+    level = prm.site_accel / (gravity * math.sqrt(coarse_s))
+    heading = prm.site_accel / (k * math.sqrt(3.0 * coarse_s * coarse_s * coarse_s))
+    w2 = wander * wander
+    add = (level * level + w2, level * level + w2, heading * heading + w2)
+    att = np.array(prm.sigma0_att, dtype=float)
+    for i in range(3):
+        s = att[i]
+        att[i] = math.sqrt(s * s + SITE_MARGIN * SITE_MARGIN * add[i])
+    prm.sigma0_att = att
 
 
 def system_matrix(prm, f_n):
@@ -108,7 +128,7 @@ def step(m, dv_sf_n, z_en):
     m.x = phi @ m.x
     m.p = (phi @ m.p) @ phi.T
     q_att = m.prm.gyro_arw * m.prm.gyro_arw * span
-    q_vel = m.prm.accel_vrw * m.prm.accel_vrw * span
+    q_vel = (m.prm.accel_vrw * m.prm.accel_vrw + m.prm.site_accel * m.prm.site_accel) * span
     for i in range(3):
         m.p[i, i] = m.p[i, i] + q_att
     for i in (VEL, VEL + 1):

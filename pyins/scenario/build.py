@@ -179,7 +179,8 @@ def _firmware_config(res, motion):
                          ("fine_accel_vrw_mps_sqrt_s", "fine_accel_vrw"),
                          ("fine_sigma0_att_rad", "fine_sigma0_att_rad"),
                          ("fine_sigma0_gyro_rad_s", "fine_sigma0_gyro"),
-                         ("fine_sigma0_accel_mps2", "fine_sigma0_accel")):
+                         ("fine_sigma0_accel_mps2", "fine_sigma0_accel"),
+                         ("fine_site_accel_mps_sqrt_s", "fine_site_accel")):
         if fw[name] is not None:
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
@@ -258,7 +259,8 @@ _FIELD_KEYS = {"lat_rad": "motion.lat", "lon_rad": "motion.lon", "height_m": "mo
                "coarse_output_every_ticks": "firmware.coarse_output_every",
                "coarse_method": "firmware.coarse_method", "fine_states": "firmware.fine_states",
                "fine_gyro_arw": "firmware.fine_gyro_arw", "fine_accel_vrw": "firmware.fine_accel_vrw",
-               "fine_sigma0_att_rad": "firmware.fine_sigma0_att"}
+               "fine_sigma0_att_rad": "firmware.fine_sigma0_att",
+               "fine_site_accel": "firmware.fine_site_accel"}
 
 
 def _firmware_check(motion, cfg):

@@ -277,6 +277,11 @@ FIRMWARE_KEYS = {
                             lo_open=True),
     "fine_sigma0_accel": Key("acceleration", "initial sigma of the biases (firmware default "
                                              "100 ug)", lo="0 ug", hi="1 g", lo_open=True),
+    "fine_site_accel": Key("velocity_random_walk", "moving base (fine_states 12): the site's slow "
+                                                   "horizontal motion, a ship ranging on its lines, as "
+                                                   "a white acceleration density (firmware default 0: "
+                                                   "a rigid site)", lo="0 ug/sqrt(Hz)",
+                           hi="10 mg/sqrt(Hz)"),
 }
 
 INITIAL_ERROR_KEYS = {

@@ -242,6 +242,8 @@ int main(void) {
     BAD_CFG(b.fine_states = 11, PYINS_E_CONFIG_FINE, "fine_states 11");
     BAD_CFG(b.fine_pos_sigma_m = -0.5, PYINS_E_CONFIG_NOISE, "negative wave displacement sigma");
     BAD_CFG(b.fine_sigma0_vel_mps = NAN, PYINS_E_CONFIG_NOISE, "NaN initial velocity sigma");
+    BAD_CFG(b.fine_site_accel = -1e-3, PYINS_E_CONFIG_NOISE, "negative site acceleration density");
+    BAD_CFG(b.fine_site_accel = NAN, PYINS_E_CONFIG_NOISE, "NaN site acceleration density");
     BAD_CFG(b.integrity_nis_window = -2, PYINS_E_CONFIG_INTEGRITY, "NIS window below -1");
     BAD_CFG(b.integrity_nis_max = -1.0, PYINS_E_CONFIG_INTEGRITY, "negative NIS bound");
     BAD_CFG(b.integrity_nis_max = NAN, PYINS_E_CONFIG_INTEGRITY, "NaN NIS bound");

@@ -37,6 +37,7 @@ FIELDS = {
     "fine_gyro_arw": values(0.0, 1e-7, -1e-7, INF),
     "fine_sigma0_att_rad": values([0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-2], [0.0, -1.0, 0.0]),
     "fine_pos_sigma_m": values(0.0, 1.0, NAN),
+    "fine_site_accel": values(0.0, 9.8e-3, -1e-3, INF),
     "index_scheme": values(0, 1, 2, 3, 4, 5, 6, 7, 8, -1),
     "index_stop_ticks": values(0, 1, -5),
     "index_n_steps": values(0, 1, 2, 8, 9),

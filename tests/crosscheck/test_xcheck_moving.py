@@ -67,17 +67,61 @@ def test_rotation_sine(e1, e2):
     assert abs(want - (np.sin(angle) if angle < np.pi / 2 else 1.0)) < 1e-12
 
 
+_MOVING_FIELDS = ("sin_lat", "cos_lat", "rm_h", "rn_h", "dt", "meas_every", "nis_window", "gyro_arw",
+                  "accel_vrw", "pos_sigma", "sigma0_vel", "sigma0_gyro", "sigma0_accel", "nis_max",
+                  "site_accel")
+
+
+def _fill(cp, prm):
+    """The hook's pyins_t_moving_params from a moving_align.Params."""
+    for name in _MOVING_FIELDS:
+        setattr(cp, name, getattr(prm, name))
+    for i in range(3):
+        cp.sigma0_att[i] = prm.sigma0_att[i]
+
+
+@settings(max_examples=50, deadline=None)
+@given(lat=st.floats(-70.0, 70.0), coarse_s=st.floats(20.0, 3600.0), wander=st.floats(0.0, 0.02),
+       site=st.sampled_from([0.0, 1e-4, 1e-3, 9.8e-3, 5e-2]), seed=st.integers(0, 1000))
+def test_sigma0_after_coarse_bit_identical(lat, coarse_s, wander, site, seed):
+    """The prior the site motion leaves a coarse result: C++ == NumPy bit for bit; nothing
+    changes on a rigid site; and the heading's share is the header's q / (k sqrt(3 T^3))."""
+    rng = np.random.default_rng(seed)
+    sl, cl = np.sin(lat * DEG), np.cos(lat * DEG)
+    rm, rn = earth.principal_radii(sl)
+    g = earth.normal_gravity(sl, 0.0)
+    att = rng.uniform(1e-4, 1e-2, 3)
+    prm = moving_align.Params(
+        sin_lat=sl, cos_lat=cl, rm_h=rm, rn_h=rn, dt=DT, meas_every=100, gyro_arw=1e-6,
+        accel_vrw=1e-4, pos_sigma=0.5, site_accel=site, sigma0_att=att.copy(), sigma0_vel=0.5,
+        sigma0_gyro=5e-8, sigma0_accel=1e-3)
+    cp = ffi.new("pyins_t_moving_params *")
+    _fill(cp, prm)
+    out = ffi.new("double[3]")
+    lib.pyins_t_moving_sigma0_after_coarse(cp, coarse_s, wander, g, out)
+    moving_align.sigma0_after_coarse(prm, coarse_s, wander, g)
+    assert list(out) == list(prm.sigma0_att)
+    if site == 0.0:
+        assert list(prm.sigma0_att) == list(att)
+    else:
+        k = g * earth.OMEGA_IE * cl / 6.0
+        heading = site / (k * np.sqrt(3.0 * coarse_s ** 3))
+        want = np.sqrt(att[2] ** 2 + 9.0 * (heading ** 2 + wander ** 2))
+        assert abs(prm.sigma0_att[2] - want) <= 1e-12 * want
+
+
 @settings(max_examples=15, deadline=None)
 @given(lat=st.floats(-70.0, 70.0), every=st.sampled_from([10, 50, 100]), n=st.integers(100, 2500),
-       window=st.sampled_from([0, 3, 10]), seed=st.integers(0, 1000))
-def test_moving_align_filter(lat, every, n, window, seed):
+       window=st.sampled_from([0, 3, 10]), seed=st.integers(0, 1000), site=st.sampled_from([False, True]))
+def test_moving_align_filter(lat, every, n, window, seed, site):
     rng = np.random.default_rng(seed)
     sl, cl = np.sin(lat * DEG), np.cos(lat * DEG)
     rm, rn = earth.principal_radii(sl)
     prm = moving_align.Params(
         sin_lat=sl, cos_lat=cl, rm_h=rm, rn_h=rn, dt=DT, meas_every=every,
         gyro_arw=rng.uniform(1e-7, 1e-5), accel_vrw=rng.uniform(1e-5, 1e-3),
-        pos_sigma=rng.uniform(0.05, 1.0), sigma0_att=rng.uniform(1e-4, 1e-2, 3),
+        pos_sigma=rng.uniform(0.05, 1.0), site_accel=rng.uniform(1e-4, 3e-2) if site else 0.0,
+        sigma0_att=rng.uniform(1e-4, 1e-2, 3),
         sigma0_vel=rng.uniform(0.05, 1.0), sigma0_gyro=rng.uniform(1e-8, 1e-6),
         sigma0_accel=rng.uniform(1e-5, 1e-3), nis_window=window, nis_max=4.0)
     dv = np.tile([0.0, 0.0, 9.8 * 0.01], (n, 1)) + rng.normal(0.0, 1e-4, (n, 3))
@@ -85,11 +129,7 @@ def test_moving_align_filter(lat, every, n, window, seed):
     m = moving_align.init(prm)
     updates = sum(moving_align.step(m, dv[k], z[k]) for k in range(n))
     cp = ffi.new("pyins_t_moving_params *")
-    for name in ("sin_lat", "cos_lat", "rm_h", "rn_h", "dt", "meas_every", "nis_window", "gyro_arw",
-                 "accel_vrw", "pos_sigma", "sigma0_vel", "sigma0_gyro", "sigma0_accel", "nis_max"):
-        setattr(cp, name, getattr(prm, name))
-    for i in range(3):
-        cp.sigma0_att[i] = prm.sigma0_att[i]
+    _fill(cp, prm)
     x = ffi.new("double[12]")
     p = ffi.new("double[144]")
     nis = ffi.new("double *")
@@ -128,3 +168,39 @@ def test_solve_eq8_bit_identical(euler, lat, t2, r, seed):
         assert np.array_equal(got, want)
         if noise == 0.0:
             assert np.abs(want - c).max() < 1e-9
+
+
+def test_moving_base_with_site_motion_firmware_cpp_equals_reference():
+    """The firmware with the site-motion model (fine_site_accel): 40 s of FIT on the ranging
+    ship, then 60 s of the moving-base filter, the prior from sigma0_after_coarse; the C core
+    and the NumPy mirror record by record (the tolerances of test_xcheck_lever's moving base:
+    one longitude ulp is 2.4e-9 of the 0.5 m measurement sigma, a random walk of them over
+    the updates stays under 1e-7 sigma)."""
+    from pyins import native, scenario, sim
+    from pyins.reference import firmware as ref_firmware
+    m = sim.moored("general", 34.246 * DEG, 108.91 * DEG, 0.0, 0.7)
+    m.linear = sim.LinearMotion(heave=m.linear.heave, surge=(*m.linear.surge, (0.5, 120.0, 0.0)),
+                                sway=(*m.linear.sway, (0.5, 120.0, np.pi / 2)))
+    cfg = scenario.initial_config(m, None, coarse_ticks=4000, coarse_method=1, fine_ticks=6000,
+                                  fine_states=12, fine_site_accel=9.8e-3)
+    n = 10000
+    dtheta, dv, alpha = sim.exact_increments(m, n)
+    out_c = native.Firmware(cfg).run(native.make_samples(dtheta, dv, alpha), every=100)
+    ref = ref_firmware.Firmware(cfg)
+    j = 0
+    for k in range(n):
+        status, r = ref.step(dtheta[k], dv[k], alpha[k])
+        assert status == 0
+        if (k + 1) % 100:
+            continue
+        c = out_c[j]
+        j += 1
+        assert c["tick"] == r["tick"] and c["state_flags"] == r["state_flags"], k
+        q_err = attitude.quat_mul(c["quat_np"], attitude.quat_conj(r["quat_np"]))
+        assert np.linalg.norm(attitude.quat_to_rotvec(attitude.quat_normalize(q_err))) < 1e-10, k
+        floor = 1e-7 * np.maximum(np.abs(r["kf_sigma"]), 1e-12)
+        assert np.all(np.abs(c["kf_sigma"] - r["kf_sigma"]) <= 1e-9 * np.abs(r["kf_sigma"]) + floor), k
+        assert np.all(np.abs(c["kf_x"] - r["kf_x"]) <= 1e-9 * np.abs(r["kf_x"]) + floor), k
+    assert j == n // 100
+    # the prior took the site term: 40 s of FIT leave phi_U far more than the default 10'
+    assert out_c["kf_sigma"][40, 2] > 100.0 * units.ARCMIN_TO_RAD

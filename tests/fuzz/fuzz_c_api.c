@@ -207,6 +207,7 @@ static const field kFields[] = {
     FLD(lever_b_m, T_F64), FLD(lever_p_m, T_F64), FLD(coarse_method, T_I32), FLD(reserved2, T_I32),
     FLD(integrity_nis_window, T_I32), FLD(fine_noise, T_I32), FLD(integrity_nis_max, T_F64),
     FLD(integrity_coarse_rad, T_F64), FLD(fine_pos_sigma_m, T_F64), FLD(fine_sigma0_vel_mps, T_F64),
+    FLD(fine_site_accel, T_F64),
 };
 #undef FLD
 #define N_FIELDS ((int)(sizeof kFields / sizeof kFields[0]))

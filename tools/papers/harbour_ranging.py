@@ -10,8 +10,11 @@ the headings and noise seeds those of tools/papers/moored_alignment.py
 The slow component is varied over DISTURBANCES below (surge and sway of the
 same amplitude and period, sway a quarter period behind, the phase turned
 by 360 / N deg from seed to seed so that the seeds see the disturbance at
-different phases). The alignment is the scenario's: FIT 120 s, then the
-moving-base 12-state filter 480 s (or --coarse / --fine).
+different phases), and the alignment over ALIGNMENTS: the issue's (FIT
+120 s, then the moving-base 12-state filter 480 s) with a rigid site (the
+firmware's default) and with the site-motion model (fine_site_accel), then
+longer with the model, the coarse phase 120 s or 300 s (or one alignment
+of your own: --coarse / --fine / --set).
 
 Every record (1 s) of every run is checked: its marine heading against the
 truth and its PYINS_STATE_ATT_VALID bit. Per disturbance: the largest
@@ -26,6 +29,7 @@ import json
 import os
 import sys
 import time
+import tomllib
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
@@ -47,6 +51,14 @@ _SWAY = {"amplitude": "0.3 m", "period": "10 s", "phase": "0 deg"}
 VALID_BIT = 1        # PYINS_STATE_ATT_VALID
 BOUND = 10.0         # arcmin: firmware.cpp's kValidHeadingSigma; a record beyond it must not be valid
 RECORD_EVERY = 100   # ticks: every record of the scenario (1 s)
+_RIGID = {"firmware.fine_site_accel": None}      # the firmware's default: a rigid site
+#: label -> (coarse, fine, further overrides); the scenario's own: fine_site_accel 1000 ug/sqrt(Hz)
+ALIGNMENTS = {
+    "120+480 s, rigid site": ("120 s", "480 s", _RIGID),
+    "120+480 s, site model": ("120 s", "480 s", {}),
+    "120+1080 s, site model": ("120 s", "1080 s", {}),
+    "300+1500 s, site model": ("300 s", "1500 s", {}),
+}
 
 
 def ship_overrides(amp, period, phase_deg):
@@ -130,6 +142,8 @@ def main(argv=None):
                     help="indices into DISTURBANCES, e.g. 3,7 (default: all)")
     ap.add_argument("--coarse", default=None, help="coarse alignment length, e.g. '300 s'")
     ap.add_argument("--fine", default=None, help="fine alignment length, e.g. '480 s'")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a further scenario override (TOML value), e.g. firmware.coarse_ratio=0.5")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--label", default="", help="a line naming the build measured (for the .md)")
     args = ap.parse_args(argv)
@@ -137,57 +151,71 @@ def main(argv=None):
     headings = tuple(int(h) for h in args.headings.split(","))
     dists = (DISTURBANCES if args.disturbances is None
              else tuple(DISTURBANCES[int(i)] for i in args.disturbances.split(",")))
-    align = {}
-    if args.coarse:
-        align["firmware.coarse_time"] = args.coarse
-    if args.fine:
-        align["firmware.fine_time"] = args.fine
+    if args.coarse or args.fine or args.set:
+        extra = {}
+        for item in args.set:
+            key, _, value = item.partition("=")
+            extra[key.strip()] = tomllib.loads(f"v = {value}")["v"]
+        variants = {"custom": (args.coarse or "120 s", args.fine or "1080 s", extra)}
+    else:
+        variants = ALIGNMENTS
     base = scenario.load(SCENARIO)
-    (spec0,) = base.with_overrides(align).runs()
-    c_s = spec0.config["coarse_ticks"] / TICK_HZ
-    f_s = spec0.config["fine_ticks"] / TICK_HZ
-    if align:
-        align["duration"] = f"{c_s + f_s:g} s"
-    t_end = c_s + f_s
     t0 = time.time()
-    jobs = [(scn, d, s, args.seeds, align) for d in dists
-            for h, scns in points(args.seeds, headings).items() for s, scn in enumerate(scns)]
+    scns = points(args.seeds, headings)
+    jobs, lengths = [], {}
+    for label, (coarse, fine, extra) in variants.items():
+        align = {"firmware.coarse_time": coarse, "firmware.fine_time": fine, **extra}
+        (spec0,) = base.with_overrides({**align, "duration": "1 d"}).runs()   # the lengths alone
+        c_s = spec0.config["coarse_ticks"] / TICK_HZ
+        f_s = spec0.config["fine_ticks"] / TICK_HZ
+        lengths[label] = (c_s, f_s, spec0.config.get("fine_site_accel", 0.0))
+        align["duration"] = f"{c_s + f_s:g} s"
+        jobs += [(label, (scn, d, s, args.seeds, align)) for d in dists
+                 for h in headings for s, scn in enumerate(scns[h])]
     if args.jobs > 1:
         with ProcessPoolExecutor(args.jobs) as ex:
-            results = list(ex.map(run_one, jobs, chunksize=2))
+            results = list(ex.map(run_one, [j for _, j in jobs], chunksize=2))
     else:
-        results = [run_one(j) for j in jobs]
+        results = [run_one(j) for _, j in jobs]
     per = {}
-    for (scn, d, s, _, _), r in zip(jobs, results):
-        per.setdefault(d, []).append(r)
+    for (label, (_, d, _, _, _)), r in zip(jobs, results):
+        per.setdefault((label, d), []).append(r)
     summary = {}
-    md = [f"Written by `.venv/bin/python tools/papers/harbour_ranging.py --seeds {args.seeds}"
+    md = ["Written by `.venv/bin/python tools/papers/harbour_ranging.py --seeds " + str(args.seeds)
           + (f" --coarse '{args.coarse}'" if args.coarse else "")
-          + (f" --fine '{args.fine}'" if args.fine else "") + "`"
-          + (f" ({args.label})" if args.label else "") + f": FIT {c_s:g} s then the moving-base "
-          f"12-state filter {f_s:g} s; headings {', '.join(str(h) for h in headings)} deg x "
-          f"{args.seeds} seeds; every record (1 s) checked.",
+          + (f" --fine '{args.fine}'" if args.fine else "")
+          + "".join(f" --set '{item}'" for item in args.set) + "`"
+          + (f" ({args.label})" if args.label else "")
+          + f": headings {', '.join(str(h) for h in headings)} deg x {args.seeds} seeds; every "
+          "record (1 s) of every run checked. Alignment: FIT coarse + moving-base 12-state filter, "
+          "lengths in seconds; 'site model': fine_site_accel = "
+          + ", ".join(sorted({f"{v[2] / 9.80665e-6:.0f} ug/sqrt(Hz)" for v in lengths.values() if v[2]}))
+          + "; 'rigid site': 0 (the firmware's default).",
           "",
-          "| slow surge+sway | runs | worst \\|heading err\\| while ATT_VALID (') | records > 10' and "
-          "ATT_VALID | first ATT_VALID, median / latest (s) | never valid | \\|heading err\\| at 300 s, "
-          f"at {t_end:g} s (worst, ') | valid at {t_end:g} s | heading sigma at {t_end:g} s (median, ') |",
-          "|---|---|---|---|---|---|---|---|---|"]
+          "| alignment | slow surge+sway | runs | worst \\|heading err\\| while ATT_VALID (') | records > 10' "
+          "and ATT_VALID | first ATT_VALID, median / latest (s) | never valid | \\|heading err\\| at 300 s, "
+          "at the end (worst, ') | valid at the end | heading sigma at the end (median, ') | coarse wander (worst, ') |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
     total_wrong = 0
-    for d in dists:
-        s = summarise(per[d], t_end)
-        name = "none (moored_general)" if d[0] is None else f"{d[0]:g} m at {d[1]:g} s"
-        summary[name] = s
-        total_wrong += s["wrong_but_valid_records"]
-        md.append(f"| {name} | {s['runs']} | {fmt(s['worst_valid_heading_err_arcmin'], '.2f')} | "
-                  f"{s['wrong_but_valid_records']} ({s['wrong_but_valid_runs']} runs) | "
-                  f"{fmt(s['first_valid_s_median'], '.0f')} / {fmt(s['first_valid_s_max'], '.0f')} | "
-                  f"{s['never_valid_runs']} | {s['heading_err_300s_max_arcmin']:.1f}, "
-                  f"{s['heading_err_end_max_arcmin']:.1f} | {s['valid_at_end_runs']} | "
-                  f"{s['sigma_end_median_arcmin']:.2f} |")
+    for label in variants:
+        c_s, f_s, _ = lengths[label]
+        for d in dists:
+            s = summarise(per[(label, d)], c_s + f_s)
+            name = "none (moored_general)" if d[0] is None else f"{d[0]:g} m at {d[1]:g} s"
+            summary[f"{label} / {name}"] = s
+            total_wrong += s["wrong_but_valid_records"]
+            md.append(f"| {label} | {name} | {s['runs']} | {fmt(s['worst_valid_heading_err_arcmin'], '.2f')} | "
+                      f"{s['wrong_but_valid_records']} ({s['wrong_but_valid_runs']} runs) | "
+                      f"{fmt(s['first_valid_s_median'], '.0f')} / {fmt(s['first_valid_s_max'], '.0f')} | "
+                      f"{s['never_valid_runs']} | {s['heading_err_300s_max_arcmin']:.1f}, "
+                      f"{s['heading_err_end_max_arcmin']:.1f} | {s['valid_at_end_runs']} | "
+                      f"{s['sigma_end_median_arcmin']:.2f} | {s['wander_max_arcmin']:.1f} |")
     md.append("")
-    md.append(f"Records more than {BOUND:g}' off in heading and flagged ATT_VALID, all disturbances: "
-              f"{total_wrong}.")
-    out = {"seeds": args.seeds, "headings_deg": list(headings), "coarse_s": c_s, "fine_s": f_s,
+    md.append(f"Records more than {BOUND:g}' off in heading and flagged ATT_VALID, per alignment: "
+              + "; ".join(f"{label}: {sum(summary[f'{label} / ' + ('none (moored_general)' if d[0] is None else f'{d[0]:g} m at {d[1]:g} s')]['wrong_but_valid_records'] for d in dists)}"
+                          for label in variants) + ".")
+    out = {"seeds": args.seeds, "headings_deg": list(headings),
+           "alignments": {k: dict(coarse_s=v[0], fine_s=v[1], fine_site_accel=v[2]) for k, v in lengths.items()},
            "label": args.label, "wrong_but_valid_records": total_wrong,
            "wall_s": time.time() - t0, "disturbances": summary}
     with open(os.path.join(args.out, "harbour.json"), "w") as f:
