@@ -44,7 +44,8 @@ def python_lines():
     ffi, lib = native.ffi, native.lib
     cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
                fine_states=12, index_scheme=2, index_stop_ticks=2000, seq_mode=1,
-               coarse_method=1, lever_b_m=[0.5, 1.5, 1.25], lever_p_m=[0.0625, 0.0, 0.0])
+               coarse_method=1, lever_b_m=[0.5, 1.5, 1.25], lever_p_m=[0.0625, 0.0, 0.0],
+               fine_site_accel=0.009765625)
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
     state = 1

@@ -30,6 +30,9 @@ void demo_config(pyins_config *cfg) {
     cfg->lever_b_m[1] = 1.5;
     cfg->lever_b_m[2] = 1.25;
     cfg->lever_p_m[0] = 0.0625;
+    /* ranging on its lines: the site-motion model (moving_align.hpp), 1000 ug/sqrt(Hz)
+       (a binary fraction near it, as the lever arms) */
+    cfg->fine_site_accel = 0.009765625;
 }
 
 int demo_fault(uint32_t k) {
