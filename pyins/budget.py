@@ -397,7 +397,7 @@ def _row(source, model, nav=None, check=None):
     return row
 
 
-def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=None):
+def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=None, phase=None, on_row=None):
     """The error budget of a scenario's run (a pyins.scenario.RunSpec),
     optionally checked against the firmware one source at a time.
 
@@ -414,43 +414,63 @@ def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=N
     ``check`` the run's and the relative differences); with noise in
     ``spec.errors`` a last row "noise": its 1 sigma (north, east, horizontal
     RMS; ``one_sigma`` True), which no single run is checked against.
+    ``phase(i, n, text)`` is called before each of the n firmware runs,
+    ``on_row(row)`` with each row as soon as it is known (the "sum" row
+    after the sources).
     """
     cfg = dict(spec.config)
     if cfg.get("coarse_ticks") or cfg.get("fine_ticks"):
-        raise ValueError("run_budget: the linear model starts navigating at t = 0 (no alignment phase)")
+        raise ValueError("the error budget's linear model navigates from t = 0: the scenario's "
+                         "firmware.coarse_time and firmware.fine_time must be 0 (no alignment phase)")
     if cfg.get("vertical_mode", 0) != 0:
-        raise ValueError("run_budget: the linear model holds the vertical channel (vertical_mode hold)")
+        raise ValueError("the error budget's linear model holds the vertical channel: the scenario's "
+                         "firmware.vertical_mode must be \"hold\"")
     n = duration_ticks or spec.duration_ticks
+    shortest = 2 * keep_every * max(1, spec.every or 1)   # the model keeps every keep_every-th record
+    if n < shortest:
+        raise ValueError(f"the duration ({n * spec.dt:g} s) is too short for the error budget: it needs "
+                         f"at least {shortest * spec.dt:g} s ({2 * keep_every} records of record_every "
+                         f"{max(1, spec.every or 1) * spec.dt:g} s; --hours or --set duration)")
     errs = deterministic(spec.errors)
+    count = [0]
+    sources = split_errors(errs)
+    total_runs = 1 + (len(sources) + int(np.any(initial_state_errors(spec.motion, cfg) != 0.0)) if check else 0)
 
-    def run(errors, config):
+    def run(errors, config, text):
+        if phase is not None:
+            phase(count[0], total_runs, text)
         res = fil.run_fil(spec.motion, n, config=config, errors=errors, table=spec.table, every=spec.every)
+        count[0] += 1
         if progress is not None:
             progress()
         return res
-    base = run(errs, cfg)
+
+    def add(row):
+        rows.append(row)
+        if on_row is not None:
+            on_row(row)
+    rows = []
+    base = run(errs, cfg, "every error together")
     budget = error_budget(spec.motion, base, errs, cfg, keep_every=keep_every,
                           noise=(spec.errors.gyro_arw, spec.errors.accel_vrw))
-    rows = []
-    sources = split_errors(errs)
     clean = {k: v for k, v in cfg.items() if k not in _INITIAL_FIELDS}
     for name in budget.names:
         model = budget.errors(name)
         if not check:
-            rows.append(_row(name, model))
+            add(_row(name, model))
             continue
         if name == INITIAL:
-            res = run(SensorErrors(), cfg)
+            res = run(SensorErrors(), cfg, f"{name} alone")
             own = error_budget(spec.motion, res, {}, cfg, keep_every=keep_every).errors(INITIAL)
         else:
-            res = run(sources[name], clean)
+            res = run(sources[name], clean, f"{name} alone")
             own = error_budget(spec.motion, res, {name: sources[name]}, clean, keep_every=keep_every).errors(name)
         nav = metrics.nav_errors(res)
-        rows.append(_row(name, own, nav, compare_with_run(own, nav)))
+        add(_row(name, own, nav, compare_with_run(own, nav)))
     total = budget.errors()
     nav = metrics.nav_errors(base)
-    rows.append(_row("sum", total, nav, compare_with_run(total, nav)))
+    add(_row("sum", total, nav, compare_with_run(total, nav)))
     sd = budget.noise()
     if sd is not None:      # not a signed share: the 1 sigma of one noise draw's (ARW, VRW)
-        rows.append(dict(_row(NOISE, sd), one_sigma=True))
+        add(dict(_row(NOISE, sd), one_sigma=True))
     return rows, budget

@@ -412,8 +412,10 @@ def _load_base(ref, source, relative_to=None):
                             source) from None
 
 
-def loads_campaign(text, source="<string>", name=None, relative_to=None):
-    """A Campaign from the TOML text of a campaign file."""
+def loads_campaign(text, source="<string>", name=None, relative_to=None, seeds=None, group_by=None):
+    """A Campaign from the TOML text of a campaign file; ``seeds`` and
+    ``group_by`` (the command line's --seeds, --group-by), when given,
+    stand for the file's own ``seeds`` and ``group_by``."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -443,7 +445,9 @@ def loads_campaign(text, source="<string>", name=None, relative_to=None):
     for key in ("name", "title", "description", "compare"):
         if key in c and not isinstance(c[key], str):
             raise ScenarioError(f"must be a string, got {c[key]!r}", f"campaign.{key}", source)
-    if "seeds" in c and isinstance(c["seeds"], str):
+    if seeds is not None:
+        c = dict(c, seeds=seeds)
+    elif "seeds" in c and isinstance(c["seeds"], str):
         raise ScenarioError(f"must be a count or an array of seeds, got the string {c['seeds']!r}",
                             "campaign.seeds", source)
     base = _load_base(c["scenario"], source, relative_to)
@@ -452,7 +456,8 @@ def loads_campaign(text, source="<string>", name=None, relative_to=None):
     labels = _flatten(c.get("labels", {}), "campaign.labels", source)
     if not grid and "seeds" not in c:
         raise ScenarioError("a campaign needs a grid ([campaign.grid]) or seeds", "campaign", source)
-    return _build(base, c["scenario"], grid, c.get("seeds"), c.get("group_by"), overrides=fixed,
+    return _build(base, c["scenario"], grid, c.get("seeds"), group_by if group_by is not None else c.get("group_by"),
+                  overrides=fixed,
                   seed_formula=c.get("seed_formula"), compare=c.get("compare", "auto"), labels=labels,
                   name=c.get("name", name), title=c.get("title"), description=c.get("description", ""),
                   source=source, random_constants=c.get("random_constants"))
@@ -463,10 +468,12 @@ def builtin_path(name):
     return scenario_mod.find_builtin(BUILTIN_DIR, name, "campaign", [n for n, _ in list_builtin()])
 
 
-def load_campaign(path_or_name):
-    """A Campaign from a campaign .toml file, or the built-in of that name."""
+def load_campaign(path_or_name, seeds=None, group_by=None):
+    """A Campaign from a campaign .toml file, or the built-in of that name;
+    ``seeds``, ``group_by`` (when given) stand for the file's own."""
     text, path = scenario_mod.read_toml_source(path_or_name, builtin_path)
-    return loads_campaign(text, source=str(path), name=path.stem, relative_to=path)
+    return loads_campaign(text, source=str(path), name=path.stem, relative_to=path, seeds=seeds,
+                          group_by=group_by)
 
 
 def list_builtin():

@@ -1,12 +1,15 @@
 """`pyins campaign` and `pyins budget`: many runs of a scenario (grids,
 Monte Carlo, local or on Dask), and each sensor error's share of one."""
+import math
 import os
 import sys
+import time
 
 from pyins import budget, campaign, scenario
 from pyins.units import NMI_TO_M
 
-from .common import EXIT_INTERRUPTED, EXIT_OK, InputError, TICKS_PER_HOUR, emit_json, say, set_overrides
+from .common import (EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
+                     set_overrides)
 
 
 #: The examples each subcommand's --help ends with.
@@ -22,11 +25,12 @@ def add_campaign(cmd):
     p.add_argument("campaign", nargs="?", help="built-in campaign name or a campaign .toml file")
     p.add_argument("--scenario", help="base scenario for --grid")
     p.add_argument("--grid", action="append", metavar="KEY=V1,V2,...")
-    p.add_argument("--seeds", help="a count N (0..N-1), a list 0,3,7 or a range 2..6 (default: the scenario's)")
-    p.add_argument("--group-by", action="append", help="grid keys to group by (default: all but seed)")
+    p.add_argument("--seeds", help="a count N (0..N-1), a list 0,3,7 or a range 2..6 (default: the campaign's own, "
+                   "else the scenario's seed)")
+    p.add_argument("--group-by", action="append", help="grid keys to group by, repeatable or a,b (default: the campaign's own, else every grid key)")
     p.add_argument("--workers", type=int, help="local processes (default: every core)")
     p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
-    p.add_argument("--out", help="campaign directory (default runs/campaign_NAME)")
+    p.add_argument("--out", help="campaign directory (default runs/campaigns/NAME)")
 
 
 def add_budget(cmd):
@@ -39,34 +43,95 @@ def add_budget(cmd):
     p.add_argument("--check", action="store_true", help="run every source alone through the firmware too")
 
 
+def _campaign_option_error(exc, args):
+    """A ScenarioError about what the command line gave (--seeds, --group-by,
+    --grid, --scenario) said in the option's name rather than the campaign
+    file's key."""
+    key = getattr(exc, "key", "") or ""
+    given = {"campaign.seeds": ("--seeds", args.seeds), "campaign.group_by": ("--group-by", args.group_by),
+             "campaign.scenario": ("--scenario", args.scenario)}
+    for k, (opt, value) in given.items():
+        if key == k and value is not None and (exc.source == "command line" or opt != "--scenario"):
+            shown = ",".join(value) if isinstance(value, list) else value
+            return InputError(f"{opt} {shown}: {exc.reason}")
+    if exc.source == "command line" and key.startswith("campaign.grid"):
+        return InputError(f"--grid {key[len('campaign.grid.'):]}: {exc.reason}")
+    if exc.source == "command line":
+        return InputError(f"{key + ': ' if key else ''}{exc.reason}")
+    return exc
+
+
+def _headline(result):
+    """The headline lines of a campaign's aggregate: per group (and variant),
+    the mean, std and max of its main metrics, in the report's units."""
+    from pyins.metrics import display
+    main = ("horizontal_error_final", "horizontal_error_max", "heading_error_final")
+    lines = []
+    groups = {g["index"]: g["label"] for g in result.get("groups", [])}
+    keyed = {}
+    for a in result.get("aggregates", []):
+        name = next((m for m in main if a["metric"].startswith(m + "_") or a["metric"] == m), None)
+        if name is not None:
+            keyed.setdefault((a["group"], a["variant"]), []).append((main.index(name), name, a))
+    for (gi, v), items in keyed.items():
+        parts = []
+        for _, name, a in sorted(items, key=lambda t: t[0]):
+            unit, scale = display(name, [a["max"]])
+            if a["mean"] is None:
+                parts.append(f"{name} none (no finite value)")
+                continue
+            std = "" if a["std"] is None else f" +- {a['std'] / scale:.3g}"
+            mx = "" if a["max"] is None else f" (max {a['max'] / scale:.3g})"
+            parts.append(f"{name} {a['mean'] / scale:.3g}{std}{mx} {unit}")
+        label = groups.get(gi, str(gi)) + (f" [{v}]" if v else "")
+        lines.append(f"  {label}: {a['count']} run(s); " + "; ".join(parts))
+    return lines
+
+
 def cmd_campaign(args):
     if args.campaign and (args.grid or args.scenario):
         raise InputError("campaign: give a campaign (NAME or FILE) or --scenario with --grid, not both")
-    if args.campaign:
-        camp = campaign.load_campaign(args.campaign)
-    elif args.scenario:
-        camp = campaign.from_args(args.scenario, args.grid or [], args.seeds, args.group_by)
-    else:
-        raise InputError("campaign: give a campaign NAME or FILE, or --scenario with --grid (see --help)")
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers {args.workers}: must be 1 or more (default: every core)")
+    group_by = ",".join(args.group_by) if args.group_by else None
+    try:
+        if args.campaign:
+            # --seeds, --group-by stand for the campaign file's own (never ignored)
+            camp = campaign.load_campaign(args.campaign, seeds=args.seeds, group_by=group_by)
+        elif args.scenario:
+            camp = campaign.from_args(args.scenario, args.grid or [], args.seeds, group_by)
+        else:
+            raise InputError("campaign: give a campaign NAME or FILE, or --scenario with --grid (see --help)")
+    except scenario.ScenarioError as exc:
+        raise _campaign_option_error(exc, args) from None
     out = args.out or campaign.default_out_dir(camp)
-    say(args, f"pyins campaign {camp.name} -> {out}")
+    n_runs = len({p.digest for p in camp.points})
+    given = [f"{o} {v}" for o, v in (("--seeds", args.seeds), ("--group-by", group_by))
+             if v is not None and args.campaign]
+    say(args, f"pyins campaign {camp.name} -> {out}: {n_runs} run(s)"
+              + (f" ({', '.join(given)} in place of the campaign's own)" if given else ""))
+    bar = CountProgress("runs", enabled=not args.quiet and not args.json)
 
     def progress(done, total, skipped=0):
-        if not args.quiet and not args.json and sys.stderr.isatty():
-            print(f"\r  {done}/{total} runs ({skipped} already done)", end="", file=sys.stderr, flush=True)
+        bar(done, total, skipped)
     try:
         result = campaign.run_campaign(camp, out, workers=args.workers, scheduler=args.scheduler,
                                        progress=progress,
                                        notice=lambda text: print(f"pyins campaign: note: {text}",
                                                                  file=sys.stderr))
     except KeyboardInterrupt as exc:
+        bar.end()
         ex = (getattr(exc, "result", None) or {}).get("execution", {})
         done = f"{ex['computed'] + ex['skipped']} of {ex['runs']} runs finished, " if ex else ""
         print(f"\npyins campaign: interrupted; {done}kept in {out}/runs; partial aggregates in "
               f"{os.path.join(out, 'aggregate.md')} (rerun the same command to resume)", file=sys.stderr)
         return EXIT_INTERRUPTED
-    if not args.quiet and not args.json and sys.stderr.isatty():
-        print(file=sys.stderr)
+    bar.end()
+    ex = result.get("execution", {})
+    say(args, f"  {ex.get('runs', n_runs)} run(s): {ex.get('computed', 0)} computed, "
+              f"{ex.get('skipped', 0)} already done, {ex.get('wall_s', 0.0):.1f} s")
+    for line in _headline(result):
+        say(args, line)
     say(args, f"  aggregates: {os.path.join(out, 'aggregate.md')}")
     emit_json(args, result)
     return EXIT_OK
@@ -87,19 +152,50 @@ def cmd_budget(args):
                              f"0 to {len(specs) - 1}")
         specs = [specs[args.variant]]
     result = []
+    quiet = args.quiet or args.json
     for spec in specs:
         say(args, f"pyins budget {scn.name} [{spec.label}], {spec.duration_ticks / TICKS_PER_HOUR:g} h"
                    + (", every source alone too" if args.check else ""))
-        rows, shares = budget.run_budget(spec, check=args.check)
-        for r in rows:
-            line = (f"  {r['source']:19s} model N {r['model_north_m'] / NMI_TO_M:+8.3f}  "
-                    f"E {r['model_east_m'] / NMI_TO_M:+8.3f}  final {r['model_final_m'] / NMI_TO_M:7.3f} nmi")
-            if "fil_final_m" in r:
-                line += (f"   FIL N {r['fil_north_m'] / NMI_TO_M:+8.3f}  E {r['fil_east_m'] / NMI_TO_M:+8.3f}"
-                         f"  final {r['fil_final_m'] / NMI_TO_M:7.3f} nmi  rel. diff. "
-                         f"{budget.budget_verdict(r)[1]}")
-            say(args, line)
-        result.append(dict(label=spec.label, rows=rows,
+        t0 = time.perf_counter()
+
+        def phase(i, n, text, t0=t0):
+            # a line per firmware run (the rows follow as they are known), with the time left
+            if quiet:
+                return
+            el = time.perf_counter() - t0
+            eta = f", about {el / i * (n - i):.0f} s left" if i else ""
+            print(f"  firmware run {i + 1}/{n}: {text} ({el:.0f} s{eta})", file=sys.stderr, flush=True)
+        rows, shares = budget.run_budget(spec, check=args.check, phase=phase,
+                                         on_row=None if quiet else _budget_line)
+        result.append(dict(label=spec.label, rows=[_budget_json_row(r) for r in rows],
                            eps_n_mean_rad_s={n: shares.eps_n_mean[i].tolist() for i, n in enumerate(shares.names)}))
     emit_json(args, dict(scenario=scn.name, variants=result))
     return EXIT_OK
+
+
+def _budget_line(r):
+    line = (f"  {r['source']:19s} model N {r['model_north_m'] / NMI_TO_M:+8.3f}  "
+            f"E {r['model_east_m'] / NMI_TO_M:+8.3f}  final {r['model_final_m'] / NMI_TO_M:7.3f} nmi")
+    if "fil_final_m" in r:
+        line += (f"   FIL N {r['fil_north_m'] / NMI_TO_M:+8.3f}  E {r['fil_east_m'] / NMI_TO_M:+8.3f}"
+                 f"  final {r['fil_final_m'] / NMI_TO_M:7.3f} nmi  rel. diff. "
+                 f"{budget.budget_verdict(r)[1]}")
+    print(line, flush=True)
+
+
+#: The relative differences of a checked row (model against its firmware run).
+_REL_KEYS = ("rel_max", "rel_24h", "rel_final", "rel_level", "rel_heading", "rel_velocity")
+
+
+def _budget_json_row(row):
+    """A budget row for --json: a relative difference that has no value (the
+    run's own error is zero there: infinity in pyins.budget) is null, and
+    ``rel_null`` says why."""
+    out = dict(row)
+    empty = [k for k in _REL_KEYS if isinstance(out.get(k), float) and not math.isfinite(out[k])]
+    for k in empty:
+        out[k] = None
+    if empty:
+        out["rel_null"] = {k: "the firmware run's own error is zero there: no relative difference "
+                              "(diff_max_m holds the absolute one)" for k in empty}
+    return out
