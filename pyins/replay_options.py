@@ -19,9 +19,11 @@ Every refusal is an `OptionError` (a ValueError): one line, exit 2.
 import numpy as np
 
 from pyins import limits, scenario, units
+from pyins.reference import abi
+from pyins.scenario import schema
 from pyins.units import ScenarioError
 
-__all__ = ["config", "rate_hz", "quantity", "NAMES", "OptionError"]
+__all__ = ["config", "rate_hz", "quantity", "limited", "ticks_of", "NAMES", "OptionError"]
 
 
 class OptionError(ValueError):
@@ -77,6 +79,58 @@ def quantity(option, text, dimension):
         raise OptionError(f"{option} {text!r}: {exc.reason}") from None
 
 
+#: the most ticks a time option may come to (the configuration's fields are 32-bit)
+MAX_TICKS = 2**31 - 1
+
+
+def ticks_of(option, seconds, hz, zero=None):
+    """A time option [s] in whole ticks at ``hz``. ``zero``: what 0 means
+    (None: 0 is not a value of this option). A time that rounds to 0 ticks
+    is refused: the firmware would read the 0 as its default or as "none"."""
+    if not (np.isfinite(seconds) and seconds >= 0):
+        raise OptionError(f"{option}: {seconds:g} s must be a time of zero or more seconds")
+    ticks = round(seconds * hz)
+    if ticks > MAX_TICKS:
+        raise OptionError(f"{option}: {seconds:g} s is more than the firmware counts "
+                          f"({MAX_TICKS / hz:.6g} s at {hz} Hz)")
+    if seconds == 0 and zero is None:
+        raise OptionError(f"{option}: 0 s is not an interval: give at least one tick "
+                          f"({1.0 / hz:g} s at {hz} Hz), or leave {option} out for the default")
+    if ticks == 0 and seconds > 0:
+        way = f"0 for {zero}, or at least" if zero else "at least"
+        raise OptionError(f"{option}: {seconds:g} s rounds to 0 ticks at {hz} Hz (a tick is "
+                          f"{1.0 / hz:g} s): give {way} one tick")
+    return int(ticks)
+
+
+def limited(option, text, key):
+    """A firmware quantity the user wrote with its unit, in SI, within the
+    limits the scenario file's key ``key`` holds it to (`pyins.scenario.schema`):
+    the same value is refused on the command line and in a scenario."""
+    k = schema.FIRMWARE_KEYS[key]
+    value = quantity(option, text, k.kind)
+    lo = None if k.lo is None else units.parse_quantity(k.lo, k.kind)
+    hi = None if k.hi is None else units.parse_quantity(k.hi, k.kind)
+    low = lo is not None and (value <= lo if k.lo_open else value < lo)
+    if not np.isfinite(value) or low or (hi is not None and value > hi):
+        zero = " (0 is not 'the default': leave the option out for that)" if value == 0 else ""
+        raise OptionError(f"{option} {text!r}: must be {'more than' if k.lo_open else 'at least'} "
+                          f"{k.lo} and at most {k.hi}{zero}")
+    return value
+
+
+def _early(cfg):
+    """The refusal of a coarse output interval too long for the first solution, in --coarse-every."""
+    r = limits.resolved(cfg)
+    hz = r["tick_hz"]
+    first, every = r["coarse_first_output_ticks"] / hz, r["coarse_output_every_ticks"] / hz
+    if r["coarse_method"] == abi.PYINS_COARSE_FIT:
+        return limits.explain(abi.PYINS_E_CONFIG_ALIGN_EARLY, cfg, NAMES)
+    return (f"--coarse-every: an output interval of {every:g} s is too long: the first coarse "
+            f"solution comes at {first:g} s and needs at least one interval of history before it "
+            f"(at most {r['coarse_ratio'] * first:g} s)")
+
+
 def config(args, data, spec, cfg, say=print):
     """The firmware configuration of a replay and its tick rate [Hz]: ``cfg``
     (the scenario's, or empty) completed from the options ``args`` and the
@@ -103,13 +157,11 @@ def config(args, data, spec, cfg, say=print):
         cfg["euler_b_rad"] = np.radians(args.attitude)
 
     # 3. the firmware's settings
-    for option, field, val in (("--coarse", "coarse_ticks", args.coarse),
-                               ("--fine", "fine_ticks", args.fine),
-                               ("--coarse-every", "coarse_output_every_ticks", args.coarse_every)):
+    for option, field, val, zero in (("--coarse", "coarse_ticks", args.coarse, "no coarse alignment"),
+                                     ("--fine", "fine_ticks", args.fine, "no fine alignment"),
+                                     ("--coarse-every", "coarse_output_every_ticks", args.coarse_every, None)):
         if val is not None:
-            if not (val >= 0 and np.isfinite(val)):
-                raise OptionError(f"{option}: {val:g} s must be a time of zero or more seconds")
-            cfg[field] = int(round(val * hz))
+            cfg[field] = ticks_of(option, val, hz, zero)
     if args.coarse_method is not None:
         cfg["coarse_method"] = scenario.COARSE_METHODS[args.coarse_method]
     if args.fine_states is not None:
@@ -120,12 +172,13 @@ def config(args, data, spec, cfg, say=print):
         cfg["fine_noise"] = scenario.FINE_NOISES[args.fine_noise]
     if args.vertical is not None:
         cfg["vertical_mode"] = args.vertical
+    # the core reads 0 here as "its default": a 0 the user wrote is refused, never swapped
     if args.fine_sigma0 is not None:
-        cfg["fine_sigma0_att_rad"] = [quantity("--fine-sigma0", t, "angle") for t in args.fine_sigma0]
+        cfg["fine_sigma0_att_rad"] = [limited("--fine-sigma0", t, "fine_sigma0_att") for t in args.fine_sigma0]
     if args.gyro_arw is not None:
-        cfg["fine_gyro_arw"] = quantity("--gyro-arw", args.gyro_arw, "angle_random_walk")
+        cfg["fine_gyro_arw"] = limited("--gyro-arw", args.gyro_arw, "fine_gyro_arw")
     if args.accel_vrw is not None:
-        cfg["fine_accel_vrw"] = quantity("--accel-vrw", args.accel_vrw, "velocity_random_walk")
+        cfg["fine_accel_vrw"] = limited("--accel-vrw", args.accel_vrw, "fine_accel_vrw")
 
     # 4. what the firmware cannot be right without, refused before it runs
     if "lat_rad" not in cfg:
@@ -137,5 +190,5 @@ def config(args, data, spec, cfg, say=print):
                           "level and facing north)")
     refused = limits.check(cfg, NAMES)
     if refused is not None:
-        raise OptionError(refused[1])
+        raise OptionError(_early(cfg) if refused[0] == abi.PYINS_E_CONFIG_ALIGN_EARLY else refused[1])
     return cfg, hz
