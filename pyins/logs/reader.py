@@ -91,12 +91,13 @@ class LogReader:
                  kind="increments", gyro_unit=None, accel_unit=None, axes="rfu", time_col=None,
                  table=None, table_unit="rad", table_angle=None, strict=True, plausibility=True,
                  gyro_scale=1.0, accel_scale=1.0, columns=None,
-                 strict_hint="read_log(..., strict=False) accepts it", _collect=False):
+                 strict_hint="read_log(..., strict=False) accepts it", name=None, _collect=False):
         for label, value in (("block", block), ("probe", probe)):
             if value is not None and not (isinstance(value, (int, np.integer)) and value >= 1):
                 raise ValueError(f"{label} must be a positive number of samples or None, got "
                                  f"{value!r}")
-        self.path, self.name = path, os.fspath(path)
+        # ``name``: what the messages call the file (a pipe's copy is named as the user gave it)
+        self.path, self.name = path, os.fspath(path) if name is None else name
         self.opt = _options(path, fmt, dt=dt, kind=kind, gyro_unit=gyro_unit,
                             accel_unit=accel_unit, axes=axes, time_col=time_col, table=table,
                             table_unit=table_unit, writing=False, gyro_scale=gyro_scale,
@@ -231,11 +232,16 @@ class LogReader:
                 intervals = np.full(m, dt_nom)
             elif state["t"] is None:
                 ticks = np.concatenate(([0], np.cumsum(steps))) + np.int64(scan.tick0_value)
-                intervals = np.concatenate(([dt_nom], np.diff(t)))
+                intervals = np.concatenate(([dt_nom], np.diff(t) / np.maximum(steps, 1)))
             else:
                 ticks = np.cumsum(steps) + np.int64(state["tick"])
-                intervals = np.diff(t)
+                intervals = np.diff(t) / np.maximum(steps, 1)
                 t = t[1:]
+            # a rate is held over its own tick: after a gap (a step of several
+            # ticks) the sample is one tick's increment, the time it spans
+            # divided by the ticks in it; the missing ticks are the bridge's
+            # (rate x the whole gap made the first sample after a 0.1 s gap
+            # 11 ticks' worth, and the bridge ramped towards it)
             gyro = gyro_raw * GYRO_UNITS[opt.kind][opt.gyro_unit]
             accel = accel_raw * ACCEL_UNITS[opt.kind][opt.accel_unit]
             if opt.kind == "rates":  # rectangular rule: rate at t_k held over [t_{k-1}, t_k]

@@ -138,10 +138,12 @@ class LogWriter(_Closing):
             intervals = np.full(tick.shape[0], dt)
         else:
             t = tick * float(dt)
+            # what the reader will use: a rate is held over its own tick, after a gap too
             if self._last_t is None:
-                intervals = np.concatenate(([dt], np.diff(t)))   # what the reader will use
+                intervals = np.concatenate(([dt], np.diff(t) / np.maximum(np.diff(tick), 1)))
             else:
-                intervals = np.diff(np.concatenate(([self._last_t], t)))
+                intervals = (np.diff(np.concatenate(([self._last_t], t)))
+                             / np.maximum(np.diff(np.concatenate(([self._last_tick], tick))), 1))
             self._last_t = t[-1]
         perm, sign = self._perm, self._sign
         gyro = np.empty_like(dtheta)

@@ -185,7 +185,10 @@ def test_round_trip_with_conversions(tmp_path, options, ulps):
 
 def test_rates_are_integrated_over_each_interval(tmp_path):
     # rectangular rule: increment_k = rate_k * (t_k - t_{k-1}); the first
-    # sample uses the nominal dt. The 0.02-s step is a gap (one missing tick).
+    # sample uses the nominal dt. The 0.02-s step is a gap (one missing tick):
+    # the sample after it is one tick's increment, rate x (0.02 s / 2 ticks),
+    # and the missing tick is the bridge's (rate x 0.02 s made it two ticks'
+    # worth, which the bridge then ramped towards)
     path = tmp_path / "rates.txt"
     path.write_text("% t wx wy wz fx fy fz\n"
                     "0.00 1 0 0 0 0 9.8\n"
@@ -193,8 +196,8 @@ def test_rates_are_integrated_over_each_interval(tmp_path):
                     "0.03 2 0 0 0 0 9.8\n"
                     "0.04 1 0 0 0 0 9.8\n")
     data = logs.read_log(path, kind="rates", time_col="first", strict=False)
-    np.testing.assert_allclose(data.dtheta_p[:, 0], [0.01, 0.01, 0.04, 0.01], rtol=1e-14)
-    np.testing.assert_allclose(data.dv_p[:, 2], [0.098, 0.098, 0.196, 0.098], rtol=1e-14)
+    np.testing.assert_allclose(data.dtheta_p[:, 0], [0.01, 0.01, 0.02, 0.01], rtol=1e-14)
+    np.testing.assert_allclose(data.dv_p[:, 2], [0.098, 0.098, 0.098, 0.098], rtol=1e-14)
     np.testing.assert_array_equal(data.tick, [0, 1, 3, 4])
     assert len(data.metadata["warnings"]) == 1 and "1 missing tick" in data.metadata["warnings"][0]
 
