@@ -24,6 +24,17 @@ def compression_of(path):
     return None
 
 
+def _what_bytes(path, comp):
+    """How the bytes of a text log were read, for a decoding error: after a
+    decompression, or as plain text although the name says compressed."""
+    if comp:
+        return f"after {comp} decompression, "
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext in COMPRESSIONS:
+        return f"not a {COMPRESSIONS[ext][0]} file (named {ext}, its first bytes are not), read as plain text: "
+    return ""
+
+
 def _opener(path):
     comp = compression_of(path)
     for name, _, opener in COMPRESSIONS.values():
@@ -50,8 +61,7 @@ def _decode(raw, path, name, strip=True):
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        comp = compression_of(path)
-        what = f"after {comp} decompression, " if comp else ""
+        what = _what_bytes(path, compression_of(path))
         raise LogError(f"{name}: {what}byte offset {exc.start}: not UTF-8 text (a binary log? "
                        f"pass fmt='binary')") from None
     return text.lstrip("\ufeff") if strip else text
@@ -110,7 +120,7 @@ def _stream_lines(path, name):
                 try:
                     text = piece.decode("utf-8")
                 except UnicodeDecodeError as exc:
-                    what = f"after {comp} decompression, " if comp else ""
+                    what = _what_bytes(path, comp)
                     raise LogError(f"{name}: {what}byte offset {offset + exc.start}: not UTF-8 "
                                    f"text (a binary log? pass fmt='binary')") from None
                 if first:

@@ -231,7 +231,8 @@ def _chunks_psins(path, name, opt, lay, size):
     first = next(lines, (1, ""))[1]
     if "PSINS" not in first or "SIMU" not in first:
         raise LogError(f"{name}: line 1: not a PSINS-format SIMU file (its first line names "
-                       f"'PSINS' and 'SIMU'), got {first.strip()[:60]!r}")
+                       f"'PSINS' and 'SIMU'), got {first.strip()[:60]!r}; to read it as another "
+                       f"layout, pass fmt='text', fmt='csv' or fmt='binary'")
     head, rows, numbers, ncol = [], [], [], None
     state = dict(k=0, dither=0.0, checked=False)
 
@@ -241,6 +242,20 @@ def _chunks_psins(path, name, opt, lay, size):
             if not (np.isfinite(ts_ms / 1000.0) and ts_ms / 1000.0 > 0 and np.isfinite(g) and g > 0):
                 raise LogError(f"{name}: header line 2: sampling interval {ts_ms!r} ms and g "
                                f"{g!r} m/s^2 must be positive")
+            # a header that lost a line reads the next line in its place (the first data
+            # line as the scale factors: the counts of one sample): refused, never run
+            lines_ = "; ".join(f"{i + 1}: {' '.join(k)}" for i, k in enumerate(PSINS_HEADER))
+            if not G_RANGE[0] <= g <= G_RANGE[1]:
+                raise LogError(f"{name}: PSINS header line 2 gives g = {g:g} m/s^2, not the Earth's "
+                               f"gravity ({G_RANGE[0]:g} to {G_RANGE[1]:g}): a header line is missing "
+                               f"or damaged (the 3 header lines are {lines_})")
+            scales = np.array(head[2][0:6], dtype=float)
+            if not np.all(np.isfinite(scales) & (scales > 0)):
+                raise LogError(f"{name}: PSINS header line 3 (the scale factors gf_x gf_y gf_z "
+                               f"[arcsec], af_x af_y af_z [ug*s]) holds "
+                               f"{' '.join(f'{v:g}' for v in scales)}: a scale factor must be "
+                               f"positive; the scale-factor line is missing (a data line read as "
+                               f"it?) or damaged")
             state["checked"] = True
         ts, g = lay.header["ts_ms"] / 1000.0, lay.header["g_mps2"]
         counts = np.array(rows, dtype=float)
@@ -406,6 +421,9 @@ def _parse_npz(path, name, opt):
 
 
 #: PSINS .imu: the data header's three lines (imufile.m, PSINS base/io)
+#: g [m/s^2] a PSINS header may give: the Earth's normal gravity spans 9.78 (equator) to
+#: 9.83 (poles), a little less at altitude; anything outside is not a g
+G_RANGE = (9.7, 9.9)
 PSINS_HEADER = (("pitch0_deg", "roll0_deg", "yaw0_deg", "ve0_mps", "vn0_mps", "vu0_mps"),
                 ("lat0_deg", "lon0_deg", "height0_m", "t0_s", "ts_ms", "g_mps2"),
                 ("gf_x_arcsec", "gf_y_arcsec", "gf_z_arcsec", "af_x_ugs", "af_y_ugs",

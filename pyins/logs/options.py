@@ -191,8 +191,9 @@ def _options(path, fmt, *, dt, kind, gyro_unit, accel_unit, axes, time_col, tabl
                  "accel_scale": (accel_scale, (1.0,))}
         extra = [k for k, (value, allowed) in given.items() if value not in allowed]
         if extra:
-            raise ValueError(f"psins: a PSINS .imu file states its units, scale factors and "
-                             f"time in its header; options {sorted(extra)} do not apply")
+            raise ValueError(f"{os.fspath(path)}: a PSINS .imu file states its units, scale factors "
+                             f"and time in its header; options {sorted(extra)} do not apply (a file "
+                             f"of another layout: pass fmt='text', fmt='csv' or fmt='binary')")
         return _Options(fmt, "increments", "rad", "m/s", table_unit, axes_matrix(axes), axes,
                         "first", False, None if dt is None else float(dt))
     if writing and fmt in ("npz", "csv"):

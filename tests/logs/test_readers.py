@@ -149,7 +149,7 @@ def test_the_peer_csv_is_replayed_through_the_cli(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == cli.EXIT_INPUT and err.count("\n") == 1
     assert "line 1" not in err and "line 2: expected 7 or 8 columns" in err
-    assert "a CSV with a header line is fmt='csv'" in err
+    assert "a CSV with a header line is --format csv" in err
 
 
 def test_one_missing_sample_replays_with_allow_gaps(tmp_path, capsys):
