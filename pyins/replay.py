@@ -71,7 +71,7 @@ def warnings(recs, aligning, hz):
         if int(last["fault_flags"]) & integrity:
             why = "an integrity test failed: the measurements do not fit the alignment's model"
         elif heading_sigma > VALID_HEADING_SIGMA:
-            why = (f"the fine alignment left a heading sigma of {heading_sigma / ARCMIN_TO_RAD:.1f}', above "
+            why = (f"the fine alignment left a heading sigma of {heading_sigma / ARCMIN_TO_RAD:.2f}', above "
                    f"{VALID_HEADING_SIGMA / ARCMIN_TO_RAD:g}': align longer")
         elif aligning:
             why = "the alignment had not ended"
@@ -81,6 +81,10 @@ def warnings(recs, aligning, hz):
     faults = abi.fault_names(last["fault_flags"])
     if faults:
         out.append("fault bits set: " + ", ".join(faults))
+    state = np.concatenate([np.ravel(last[k]) for k in ("lat_rad", "lon_rad", "euler_b_rad")])
+    if not np.all(np.isfinite(state)):
+        out.append(f"the navigation state at the end ({t:g} s) is not a number (NaN): the log's "
+                   "values or its declared units cannot be right")
     return out
 
 
@@ -107,6 +111,7 @@ class _Summary:
         self.t_first = t_first
         self.outside = 0          # records outside a truth track's time span
         self.records = 0
+        self.navigating = 0       # records in navigation (an alignment holds the site: nothing to compare)
         self.last = self.first_nav = self.last_fine = None
         self.horizontal_max = self.level_max = self.speed_max = -np.inf
         self.e_last = None
@@ -114,6 +119,7 @@ class _Summary:
 
     def add(self, recs):
         self.records += len(recs)
+        self.navigating += int(np.count_nonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE))
         self.last = recs[-1:].copy()
         if self.first_nav is None:
             nav = np.flatnonzero(recs["mode"] == abi.PYINS_MODE_NAVIGATE)
@@ -173,10 +179,14 @@ class _Summary:
             pitch, roll, yaw = np.degrees(first["euler_b_rad"][0])
             summary["aligned"] = dict(time_s=float(first["tick"][0] / hz), pitch_deg=float(pitch),
                                       roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)))
-        fine = alignment_figures(self.last_fine) if self.last_fine is not None else None
+        # the filter's state at the end of the fine alignment: the first record of navigation
+        # holds it (the last fine record is up to a record interval before the end)
+        end = None if self.first_nav is None else self.first_nav[0]
+        fine = alignment_figures(self.last_fine, end) if self.last_fine is not None else None
         if fine is not None:
             summary["fine_alignment"] = fine
         summary["warnings"] = warnings(recs, aligning, hz)
+        summary["navigating_records"] = self.navigating
         if self.spec is not None:
             summary["errors"] = dict(reference=f"the truth of {self.spec.scenario}",
                                      horizontal_max_m=self.horizontal_max,
@@ -219,8 +229,40 @@ def _blocks(data, block):
     return iter(data)
 
 
+#: the files a replay writes into its directory (and their temporary names: NAME.*)
+OWN_FILES = ("navigation.npz", "errors.npz", "summary.json", "report.html", "attitude.png",
+             "alignment.png", "errors.png")
+
+
+def _own(name):
+    return name in OWN_FILES or any(name.startswith(f + ".") for f in OWN_FILES)
+
+
+def claim_dir(out_dir):
+    """Make ``out_dir`` the new replay's: an earlier replay's files there
+    (`OWN_FILES`, and the temporary files a killed one left) are removed, so
+    that nothing of it (an errors.npz the new replay has no reference for)
+    is read as the new one's; a directory holding anything else (a `pyins
+    run`, files of the user's) is refused (ValueError), never mixed into.
+    Returns True when the directory was made here."""
+    if not os.path.isdir(out_dir):
+        if os.path.exists(out_dir):
+            raise ValueError(f"--out {out_dir}: not a directory")
+        os.makedirs(out_dir)
+        return True
+    names = os.listdir(out_dir)
+    other = sorted(n for n in names if not _own(n))
+    if other:
+        shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
+        raise ValueError(f"--out {out_dir}: holds files that are not a replay's ({shown}): give an "
+                         "empty or new directory, or one an earlier replay wrote (it is replaced)")
+    for n in names:
+        os.remove(os.path.join(out_dir, n))
+    return False
+
+
 def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None,
-           block=BLOCK, progress=None, t_first=None):
+           block=BLOCK, progress=None, t_first=None, notes=None):
     """Run a recorded IMU log through the firmware configured by ``cfg`` into
     ``out_dir`` and return the summary dict (also summary.json). ``data``: a
     pyins.sim.io.ImuData, or an iterable of them in order (the blocks of a
@@ -232,6 +274,10 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     a trajectory on the log's clock, ``t_first`` the time stamp of the log's
     first sample on it (None: the log has no time column; a sample's time is
     then its tick x dt). ``progress(samples_done)`` after each block.
+    ``notes()``: the warnings of the log itself (its gaps, their bridge),
+    asked for when the blocks are out and kept first in the summary's.
+    ``out_dir`` is the replay's (`claim_dir`: an earlier replay there is
+    replaced, anything else refused).
 
     Ctrl-C (KeyboardInterrupt) between blocks, or in one (a block is at most
     ``block`` samples: well under a second): the records so far are written
@@ -241,15 +287,16 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     leaves no navigation.npz or summary.json."""
     # the guarded prefix
     engines.check(engine)
-    every = max(1, int(every))
+    if not every >= 1:
+        raise ValueError(f"--every {every}: keep one record every 1 or more samples")
+    every = int(every)
     if reference is not None and not isinstance(reference, TruthTrack) and reference not in REFERENCES:
         raise ValueError(f"reference: {reference!r} is not one of {', '.join(REFERENCES)}")
     hz = cfg.get("tick_hz") or TICK_HZ
 
     # 1. the log through the firmware, block by block, the records written as they come
     fw = engines.firmware(engine, cfg)
-    made = not os.path.isdir(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
+    made = claim_dir(out_dir)
     nav = logs.NpzWriter(os.path.join(out_dir, "navigation.npz"))
     err = logs.NpzWriter(os.path.join(out_dir, "errors.npz"))
     acc = _Summary(cfg, hz, spec, reference, err, t_first=t_first)
@@ -282,6 +329,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
                                  f"interval ({every} samples): nothing to report (a smaller --every, or a "
                                  f"longer log)")
             summary = acc.summary(log_path, samples, every)
+            summary["warnings"][:0] = list(notes() if notes is not None else ())
             if interrupted:
                 t = float(acc.last["tick"][0] / hz)
                 summary.update(complete=False, state="interrupted")

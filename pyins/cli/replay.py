@@ -6,6 +6,8 @@ import sys
 import numpy as np
 
 from pyins import engine, logs, replay, replay_options, report, scenario, truth_track
+from pyins.reference import abi
+from pyins.report import replay as report_replay
 
 from .common import EXIT_INTERRUPTED, EXIT_OK, InputError, default_out, emit_json, progress_bars, say
 
@@ -73,7 +75,109 @@ def add_replay(cmd):
                    help="the firmware: native (compiled, default) or reference (NumPy mirror)")
 
 
+#: the reader's words for its Python arguments, as the command line says them
+_CLI_WORDS = (("pass fmt= one of", "give --format, one of"), ("fmt='binary'", "--format binary"),
+              ("fmt='csv'", "--format csv"), ("fmt='text'", "--format text"), ("fmt='psins'", "--format psins"),
+              ("fmt='npz'", "--format npz"), ("fmt ", "--format "),
+              ("time_col='none'", "--time-col none"), ("time_col='first'", "--time-col first"),
+              ("time_col='last'", "--time-col last"), ("pass dt", "give --rate HZ (or --dt S)"),
+              ("differs from dt=", "differs from --dt "), ("table_angle given", "--table-angle given"),
+              ("table_angle does not apply", "--table-angle does not apply"),
+              ("or pass the names", "or name them with --columns"),
+              ("unit, axis, scale and column options", "--kind, --gyro-unit, --accel-unit, --axes, "
+                                                      "--gyro-scale, --accel-scale and --columns"))
+
+
+def _cli_words(msg):
+    import re
+    for python, cli in _CLI_WORDS:
+        msg = msg.replace(python, cli)
+    # the reader's option names in a list ("options ['time_col'] do not apply")
+    return re.sub(r"options \[([^\]]*)\]", lambda m: "options " + ", ".join(
+        "--" + k.strip(" '").replace("_", "-") for k in m.group(1).split(",")), msg)
+
+
+def _positive(option, value, what):
+    if value is not None and not (np.isfinite(value) and value > 0):
+        raise InputError(f"{option}: {value:g} must be {what}")
+
+
+def _check_reader_options(args):
+    """The reader's numeric options, refused when they cannot be right (one line each)."""
+    _positive("--dt", args.dt, "a positive sample interval [s]")
+    _positive("--gyro-scale", args.gyro_scale, "a positive unit per count")
+    _positive("--accel-scale", args.accel_scale, "a positive unit per count")
+    if args.table_angle is not None and not np.isfinite(args.table_angle):
+        raise InputError(f"--table-angle: {args.table_angle:g} deg is not an angle")
+    for option, value in (("--lat", args.lat), ("--lon", args.lon), ("--height", args.height)):
+        if value is not None and not np.isfinite(value):
+            raise InputError(f"{option}: {value:g} is not a number")
+    if args.attitude is not None and not np.all(np.isfinite(args.attitude)):
+        raise InputError("--attitude: each of PITCH ROLL YAW must be a number of degrees")
+    if args.every is not None and args.every < 1:
+        raise InputError(f"--every {args.every}: keep one record every 1 or more samples")
+
+
+def _spool(log, fmt):
+    """A log read from a pipe or standard input ('-') is read once: copied to
+    a temporary file, whose path is returned with the format (told by the
+    name the user gave; a pipe with no extension needs --format). A plain
+    file is returned as it is (None: nothing to remove)."""
+    import shutil
+    import stat
+    import tempfile
+    if log != "-":
+        try:
+            mode = os.stat(log).st_mode
+        except OSError as exc:
+            raise InputError(f"{log}: {exc.strerror}") from None
+        if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+            if stat.S_ISDIR(mode):
+                raise InputError(f"{log}: a directory, not a log file")
+            return log, fmt, None
+    if fmt is None:
+        try:
+            fmt = logs.format_of(log) if log != "-" else None
+        except ValueError:
+            fmt = None
+        if fmt is None:
+            raise InputError(f"{'standard input' if log == '-' else log}: a pipe has no extension to tell "
+                             f"the format by: give --format ({', '.join(logs.FORMATS)})")
+    fd, tmp = tempfile.mkstemp(prefix="pyins-replay-", suffix=".log")
+    try:
+        with os.fdopen(fd, "wb") as dst:
+            src = sys.stdin.buffer if log == "-" else open(log, "rb")
+            try:
+                shutil.copyfileobj(src, dst, 1 << 22)
+            finally:
+                if log != "-":
+                    src.close()
+    except BaseException:
+        os.remove(tmp)
+        raise
+    return tmp, fmt, tmp
+
+
 def cmd_replay(args):
+    _check_reader_options(args)
+    path, fmt, spooled = _spool(args.log, args.format)
+    try:
+        return _replay(args, path, fmt)
+    except (ValueError, InputError) as exc:
+        msg = _cli_words(str(exc))
+        if spooled is not None:
+            msg = msg.replace(spooled, "standard input" if args.log == "-" else args.log)
+        raise InputError(msg) from exc
+    finally:
+        if spooled is not None:
+            os.remove(spooled)
+
+
+def _replay(args, path, fmt):
+    if args.time_col == "none" and args.dt is None and args.rate is not None:
+        args.dt = 1.0 / args.rate      # --rate states the interval of a log without time (its --help)
+
+
     read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
                    axes=args.axes, time_col=args.time_col, gyro_scale=args.gyro_scale,
                    accel_scale=args.accel_scale)
@@ -82,7 +186,7 @@ def cmd_replay(args):
     if args.columns is not None:
         read_kw["columns"] = logs.parse_columns(args.columns, "--columns")
     # the log in blocks (bounded memory); opening it reads the probe: the rate, the header, the unit checks
-    data = logs.LogReader(args.log, args.format, strict=not args.allow_gaps,
+    data = logs.LogReader(path, fmt, strict=not args.allow_gaps, name=args.log if path != args.log else None,
                           strict_hint="--allow-gaps replays it, bridging the gaps",
                           **{k: v for k, v in read_kw.items() if v is not None})
     blocks, bridge = data.blocks(), None
@@ -115,11 +219,15 @@ def cmd_replay(args):
         if args.reference is not None:
             raise InputError("--truth: one reference at a time (--reference or --truth)")
         reference, truth_of = truth_track.read_track(args.truth), None
+    def notes():        # the log's warnings (gaps), and the bridge's, kept in the summary
+        return [*(data.warnings or ()), *([bridge.note()] if bridge is not None and bridge.note() else [])]
+
     bar = progress_bars(args)
     bar = bar(f"replaying {args.log}") if bar is not None and data.n else None
     try:
         summary = replay.replay(blocks, cfg, out_dir, every=every, spec=truth_of, engine=args.engine,
-                                log_path=args.log, reference=reference, t_first=data.metadata.get("t_first"),
+                                log_path=None if args.log == "-" else args.log, reference=reference,
+                                t_first=data.metadata.get("t_first"), notes=notes,
                                 progress=None if bar is None else (lambda done: bar(min(done, data.n), data.n)))
     except KeyboardInterrupt:
         if os.path.exists(os.path.join(out_dir, "summary.json")):
@@ -128,8 +236,6 @@ def cmd_replay(args):
         else:
             print("\npyins replay: interrupted before the first record: nothing written", file=sys.stderr)
         return EXIT_INTERRUPTED
-    for w in data.warnings + ([bridge.note()] if bridge is not None and bridge.note() else []):
-        print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     page = report.render(out_dir)
     say(args, f"pyins replay {args.log}: {summary['samples']} samples at {hz} Hz "
                f"-> {out_dir}/navigation.npz")
@@ -144,15 +250,21 @@ def cmd_replay(args):
                    + ("measured in the coarse phase" if measured > 0.0 and measured == fa["r_vrw_ug_sqrt_hz"]
                       else "configured") + f"), heading sigma {fa['sigma_heading_arcmin']:.2f}', NIS {fa['nis']:.2f}")
     fin = summary["final"]
-    say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, mode {fin['mode']}, "
-               f"faults {fin['fault_flags']}")
+    faults = abi.fault_names(fin["fault_flags"])
+    mode = report_replay.MODES.get(fin["mode"], f"mode {fin['mode']}")
+    say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, {mode}, "
+               f"faults {', '.join(faults) or 'none'}")
     for w in summary.get("warnings", ()):
         print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     if "errors" in summary:
         er = summary["errors"]
         extra = (f", final heading {er['heading_final_arcmin']:.3f}'" if "heading_final_arcmin" in er
                  else f", max speed {er['speed_max_mps']:.3f} m/s" if "speed_max_mps" in er else "")
-        say(args, f"  against {er['reference']}: max horizontal {er['horizontal_max_m']:.2f} m{extra}")
+        if summary.get("navigating_records") == 0:
+            say(args, f"  against {er['reference']}: nothing compared: no record is of navigation (the "
+                       "alignment, which holds the site, covered the whole log)")
+        else:
+            say(args, f"  against {er['reference']}: max horizontal {er['horizontal_max_m']:.2f} m{extra}")
     say(args, f"  report: {page}")
     emit_json(args, summary)
     if "errors_missing" in summary:

@@ -28,8 +28,11 @@ from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
 
 __all__ = ["render", "is_replay"]
 
-_MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
+MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
           abi.PYINS_MODE_FINE_ALIGN: "fine alignment", abi.PYINS_MODE_NAVIGATE: "navigation"}
+_MODES = MODES
+
+
 def is_replay(summary):
     """True for the summary.json of ``pyins replay`` (it names its log)."""
     return "log" in summary and "samples" in summary
@@ -120,13 +123,15 @@ def plot_errors(err, path):
     plt.close(fig)
 
 
-def alignment_figures(rec):
-    """The fine alignment's result at its last record: attitude sigmas and
-    the drift and bias estimates (in the units of seed 001's figures)."""
+def alignment_figures(rec, end=None):
+    """The fine alignment's result at its last record (``end``: the record
+    that holds its final state, the first of navigation, when there is one):
+    attitude sigmas and the drift and bias estimates (in the units of seed
+    001's figures)."""
     fine = rec[rec["mode"] == abi.PYINS_MODE_FINE_ALIGN]
     if not len(fine):
         return None
-    last = fine[-1]
+    last = fine[-1] if end is None or not end["kf_states"] else end
     out = dict(states=int(last["kf_states"]), time_s=None,
                sigma_level_arcsec=[float(s / ARCSEC_TO_RAD) for s in last["kf_sigma"][PHI][:2]],
                sigma_heading_arcmin=float(last["kf_sigma"][PHI][2] / ARCMIN_TO_RAD),
@@ -228,10 +233,14 @@ def render(out_dir):
                              ", ".join(f"{d:.4f}" for d in fa["drift_nu_dph"])))
     fin = summary["final"]
     faults = abi.fault_names(fin["fault_flags"])
-    rows.append(_row("final", f"{_MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
+    rows.append(_row("final", f"{MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
                               f"{fin['lon_deg']:.6f} E; faults: {', '.join(faults) or 'none'}"))
     er = summary.get("errors")
-    if er:
+    if er and summary.get("navigating_records") == 0:
+        rows.append(_row(f"against {er.get('reference', 'the truth')}",
+                         "nothing compared: no record is of navigation (the alignment, which holds the site, "
+                         "covered the whole log)"))
+    elif er:
         rows.append(_row(f"against {er.get('reference', 'the truth')}",
                          f"max horizontal {er['horizontal_max_m']:.2f} m, final {er['horizontal_final_m']:.2f} m"))
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in summary.get("warnings", ()))
