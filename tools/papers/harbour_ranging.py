@@ -13,8 +13,8 @@ by 360 / N deg from seed to seed so that the seeds see the disturbance at
 different phases), and the alignment over ALIGNMENTS: the issue's (FIT
 120 s, then the moving-base 12-state filter 480 s) with a rigid site (the
 firmware's default) and with the site-motion model (fine_site_accel), then
-longer with the model, the coarse phase 120 s or 300 s (or one alignment
-of your own: --coarse / --fine / --set).
+longer with the model, the coarse phase 120, 300 or 600 s (or one
+alignment of your own: --coarse / --fine / --set).
 
 Every record (1 s) of every run is checked: its marine heading against the
 truth and its PYINS_STATE_ATT_VALID bit. Per disturbance: the largest
@@ -22,7 +22,7 @@ heading error among the ATT_VALID records, the records more than 10' off
 that are still ATT_VALID (must be 0), the earliest ATT_VALID time (the
 first valid record of each run: its median and largest over the runs, and
 the runs that never become valid), and the heading error at 300 s and at the
-end. Writes harbour.json and harbour.md into --out (~3 s per run and core).
+end. Writes harbour.json and harbour.md into --out (~15 min with --jobs 2).
 """
 import argparse
 import json
@@ -49,6 +49,7 @@ DISTURBANCES = ((None, None), (0.5, 60), (0.5, 90), (0.5, 120), (0.5, 150), (0.5
 _SURGE = {"amplitude": "0.3 m", "period": "12 s", "phase": "0 deg"}
 _SWAY = {"amplitude": "0.3 m", "period": "10 s", "phase": "0 deg"}
 VALID_BIT = 1        # PYINS_STATE_ATT_VALID
+NIS_BIT, WANDER_BIT = 256, 512   # PYINS_FAULT_ALIGN_INCONSISTENT, PYINS_FAULT_COARSE_UNSETTLED
 BOUND = 10.0         # arcmin: firmware.cpp's kValidHeadingSigma; a record beyond it must not be valid
 RECORD_EVERY = 100   # ticks: every record of the scenario (1 s)
 _RIGID = {"firmware.fine_site_accel": None}      # the firmware's default: a rigid site
@@ -58,6 +59,7 @@ ALIGNMENTS = {
     "120+480 s, site model": ("120 s", "480 s", {}),
     "120+1080 s, site model": ("120 s", "1080 s", {}),
     "300+1500 s, site model": ("300 s", "1500 s", {}),
+    "600+1200 s, site model": ("600 s", "1200 s", {}),
 }
 
 
@@ -113,7 +115,8 @@ def summarise(runs, t_end):
     seen = [f for f in firsts if f is not None]
 
     def at(t):
-        return max(r["err"][r["t"].index(t)] for r in runs if t in r["t"])
+        v = [r["err"][r["t"].index(t)] for r in runs if t in r["t"]]
+        return max(v) if v else None
 
     return dict(runs=len(runs), records=sum(len(r["t"]) for r in runs),
                 worst_valid_heading_err_arcmin=max(errs_valid) if errs_valid else None,
@@ -126,7 +129,9 @@ def summarise(runs, t_end):
                 heading_err_300s_max_arcmin=at(300.0), heading_err_end_max_arcmin=at(t_end),
                 valid_at_end_runs=sum(1 for r in runs if r["valid"][-1]),
                 sigma_end_median_arcmin=float(np.median([r["sigma"][-1] for r in runs])),
-                wander_max_arcmin=max(r["wander"] for r in runs))
+                wander_max_arcmin=max(r["wander"] for r in runs),
+                coarse_unsettled_runs=sum(1 for r in runs if r["faults"] & WANDER_BIT),
+                inconsistent_runs=sum(1 for r in runs if r["faults"] & NIS_BIT))
 
 
 def fmt(v, spec=".1f"):
@@ -194,8 +199,9 @@ def main(argv=None):
           "",
           "| alignment | slow surge+sway | runs | worst \\|heading err\\| while ATT_VALID (') | records > 10' "
           "and ATT_VALID | first ATT_VALID, median / latest (s) | never valid | \\|heading err\\| at 300 s, "
-          "at the end (worst, ') | valid at the end | heading sigma at the end (median, ') | coarse wander (worst, ') |",
-          "|---|---|---|---|---|---|---|---|---|---|---|"]
+          "at the end (worst, ') | valid at the end | heading sigma at the end (median, ') | coarse wander (worst, ') "
+          "| runs flagged: coarse unsettled, NIS |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     total_wrong = 0
     for label in variants:
         c_s, f_s, _ = lengths[label]
@@ -207,9 +213,10 @@ def main(argv=None):
             md.append(f"| {label} | {name} | {s['runs']} | {fmt(s['worst_valid_heading_err_arcmin'], '.2f')} | "
                       f"{s['wrong_but_valid_records']} ({s['wrong_but_valid_runs']} runs) | "
                       f"{fmt(s['first_valid_s_median'], '.0f')} / {fmt(s['first_valid_s_max'], '.0f')} | "
-                      f"{s['never_valid_runs']} | {s['heading_err_300s_max_arcmin']:.1f}, "
-                      f"{s['heading_err_end_max_arcmin']:.1f} | {s['valid_at_end_runs']} | "
-                      f"{s['sigma_end_median_arcmin']:.2f} | {s['wander_max_arcmin']:.1f} |")
+                      f"{s['never_valid_runs']} | {fmt(s['heading_err_300s_max_arcmin'])}, "
+                      f"{fmt(s['heading_err_end_max_arcmin'])} | {s['valid_at_end_runs']} | "
+                      f"{s['sigma_end_median_arcmin']:.2f} | {s['wander_max_arcmin']:.1f} | "
+                      f"{s['coarse_unsettled_runs']}, {s['inconsistent_runs']} |")
     md.append("")
     md.append(f"Records more than {BOUND:g}' off in heading and flagged ATT_VALID, per alignment: "
               + "; ".join(f"{label}: {sum(summary[f'{label} / ' + ('none (moored_general)' if d[0] is None else f'{d[0]:g} m at {d[1]:g} s')]['wrong_but_valid_records'] for d in dists)}"
