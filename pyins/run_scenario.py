@@ -110,55 +110,77 @@ def _start(scn, run_dir, resume, engine, force):
 
 def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupted):
     # 2. each variant: the checkpointed run, its records, metrics and time series
-    for i, spec in enumerate(specs):
-        vdir = os.path.join(run_dir, slug(spec.label))
-        entry = summary["variants"][i]
-        t0 = time.perf_counter()
-        try:
-            if interrupted is not None:
-                raise interrupted
-            if not resume and os.path.exists(vdir):
-                shutil.rmtree(vdir)
-            os.makedirs(vdir, exist_ok=True)
-            for name in ("timeseries.npz", "timeseries.csv"):      # derived: rewritten at the end
-                if os.path.exists(os.path.join(vdir, name)):
-                    os.remove(os.path.join(vdir, name))
-            checkpoint = int(round(CHECKPOINT_S / spec.dt))
-            bar = progress(spec.label) if progress else None
-            run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
-                checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint), progress=bar)
-            with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
-                res, info = load_variant(run_dir, spec)
-                mm = metrics.run_metrics(spec, res) if res is not None else {}
-                if res is not None and len(res.outputs):
-                    records.write_timeseries(vdir, res)
-            entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
-                         complete=bool(info and info.get("complete")), metrics=mm)
-        except KeyboardInterrupt as exc:
-            # at once: the ticks on disk; the metrics of a stopped variant are the report's
-            interrupted = interrupted or exc.with_traceback(None)
-            with hold_interrupts():
-                entry.update(wall_s=time.perf_counter() - t0, complete=False, metrics={},
-                             ticks_done=written_ticks(run_dir, spec) if os.path.isdir(vdir) else 0)
-            continue
-        if log is not None:
-            log(f"  {spec.label}: {entry['ticks_done'] * spec.dt / 3600:.3g} h, "
-                f"max horizontal error {mm.get('horizontal_error_max', float('nan')):.1f} m, "
-                f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
-                f"({entry['wall_s']:.1f} s)")
-        try:
-            with hold_interrupts(defer=True):
-                write_summary(run_dir, summary)
-        except KeyboardInterrupt as exc:       # during the write (raised after it) or just before
-            interrupted = exc.with_traceback(None)
+    # a Ctrl-C between the variants' blocks (the loop's head, before the last write) stops
+    # the run here too: the summary below is written whatever line it came at
+    last = hold_interrupts(defer=True)
+    try:
+        for i, spec in enumerate(specs):
+            vdir = os.path.join(run_dir, slug(spec.label))
+            entry = summary["variants"][i]
+            t0 = time.perf_counter()
+            finished = False          # the variant's time series written: it is done, whatever comes after
+            try:
+                if interrupted is not None:
+                    raise interrupted
+                if not resume and os.path.exists(vdir):
+                    shutil.rmtree(vdir)
+                os.makedirs(vdir, exist_ok=True)
+                for name in ("timeseries.npz", "timeseries.csv"):      # derived: rewritten at the end
+                    if os.path.exists(os.path.join(vdir, name)):
+                        os.remove(os.path.join(vdir, name))
+                checkpoint = int(round(CHECKPOINT_S / spec.dt))
+                bar = progress(spec.label) if progress else None
+                run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
+                    checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint), progress=bar)
+                with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
+                    res, info = load_variant(run_dir, spec)
+                    mm = metrics.run_metrics(spec, res) if res is not None else {}
+                    with hold_interrupts(defer=True):     # the time series and "finished" together
+                        if res is not None and len(res.outputs):
+                            records.write_timeseries(vdir, res)
+                        finished = True
+                entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
+                             complete=bool(info and info.get("complete")), metrics=mm)
+            except KeyboardInterrupt as exc:
+                # at once: the ticks on disk; the metrics of a stopped variant are the report's
+                interrupted = interrupted or exc.with_traceback(None)
+                with hold_interrupts():
+                    if finished:                 # it ended as the Ctrl-C came: kept whole, as done
+                        entry.update(wall_s=time.perf_counter() - t0, metrics=mm, complete=bool(
+                            info and info.get("complete")), ticks_done=int(info["ticks_done"]) if info else 0)
+                    else:
+                        entry.update(wall_s=time.perf_counter() - t0, complete=False, metrics={},
+                                     ticks_done=written_ticks(run_dir, spec) if os.path.isdir(vdir) else 0)
+                if not finished:
+                    continue
+            try:
+                if log is not None and interrupted is None:
+                    log(f"  {spec.label}: {entry['ticks_done'] * spec.dt / 3600:.3g} h, "
+                        f"max horizontal error {mm.get('horizontal_error_max', float('nan')):.1f} m, "
+                        f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
+                        f"({entry['wall_s']:.1f} s)")
+                with hold_interrupts(defer=True):
+                    write_summary(run_dir, summary)
+            except KeyboardInterrupt as exc:       # during the write (raised after it) or just before
+                interrupted = exc.with_traceback(None)
+        last.__enter__()
+    except KeyboardInterrupt as exc:
+        interrupted = interrupted or exc.with_traceback(None)
+        last.__enter__()
 
-    # 3. the summary, over the variants
-    with hold_interrupts(defer=interrupted is None):
+    # 3. the summary, over the variants (Ctrl-C held off since the loop's end)
+    try:
         summary["group_metrics"] = group_metrics(summary["variants"])
         summary["complete"] = all(v["complete"] for v in summary["variants"])
         summary["state"] = "interrupted" if interrupted is not None else (
             "complete" if summary["complete"] else "partial")
         write_summary(run_dir, summary)
+    finally:
+        last.defer = interrupted is None
+        try:
+            last.__exit__(None, None, None)
+        except KeyboardInterrupt as exc:
+            interrupted = exc.with_traceback(None)
     if interrupted is not None:
         raise interrupted
     return summary
