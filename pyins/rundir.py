@@ -41,9 +41,12 @@ from pyins.units import ScenarioError
 
 __all__ = ["slug", "load_variant", "load_written", "check_run_dir", "clean_run_dir", "dir_digest", "read_summary",
            "write_summary", "scenario_of", "written_ticks", "written_durations", "uses_index_sums",
-           "variant_facts", "hold_interrupts", "RunDirError", "SUMMARY", "RUN_FILES"]
+           "variant_facts", "hold_interrupts", "RunDirError", "SUMMARY", "RUN_FILES", "FORMAT",
+           "summary_for_report"]
 
 SUMMARY = "summary.json"
+#: The layout of summary.json a run writes (``"format"``); a newer one is refused by the report
+FORMAT = 1
 
 
 def slug(label):
@@ -77,6 +80,64 @@ def read_summary(run_dir):
             return json.load(f)
     except (OSError, ValueError):
         return None
+
+
+def _summary_problem(summary):
+    """What makes a parsed summary.json unreadable as a run's, or None."""
+    if not isinstance(summary, dict):
+        return f"holds a JSON {type(summary).__name__}, not a run's summary (an object)"
+    fmt = summary.get("format", FORMAT)
+    if isinstance(fmt, int) and fmt > FORMAT:
+        return (f"was written by a newer pyins (summary format {fmt}; this one reads up to {FORMAT}): "
+                "report it with that version")
+    if "variants" not in summary:
+        if "max_horizontal_error_m" in summary and "ship_time_h" in summary:
+            return ("is the summary of `pyins demo`, which has no report: its figures are in that file and "
+                    "navigation_errors.png beside it")
+        return "has no 'variants': not the summary of a `pyins run` (damaged, or another program's)"
+    vs = summary["variants"]
+    if not isinstance(vs, list) or not all(isinstance(v, dict) and isinstance(v.get("label"), str)
+                                           and isinstance(v.get("dir"), str) for v in vs):
+        return "has a damaged 'variants' list (each variant needs its label and dir)"
+    for key in ("title", "scenario", "digest"):
+        if not isinstance(summary.get(key), str):
+            return f"has no {key!r} (damaged)"
+    for v in vs:
+        if not isinstance(v.get("metrics", {}), dict) or not isinstance(v.get("ticks", 0), int):
+            return f"has a damaged entry for variant {v['label']!r} (metrics, ticks)"
+    return None
+
+
+def summary_for_report(run_dir):
+    """summary.json of ``run_dir`` for a report, or RunDirError (exit 2)
+    naming the file, what is wrong with it and what can still be done."""
+    if not os.path.exists(run_dir):
+        raise RunDirError(f"{run_dir}: no such directory")
+    if not os.path.isdir(run_dir):
+        raise RunDirError(f"{run_dir}: a file, not a run directory (`pyins report` takes the directory "
+                          "`pyins run` or `pyins replay` wrote)")
+    path = os.path.join(run_dir, SUMMARY)
+    started = os.path.exists(os.path.join(run_dir, "resolved_scenario.json"))
+    again = (f"; `pyins run SCENARIO --out {run_dir} --resume` with the scenario it ran rewrites it from "
+             "the records" if started else "")
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except FileNotFoundError:
+        if started:
+            raise RunDirError(f"{path}: missing: the run stopped before it wrote its summary, or it was "
+                              f"deleted{again}") from None
+        raise RunDirError(f"{run_dir}: not a run directory (no {SUMMARY})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RunDirError(f"{path}: cannot be read ({exc}){again}") from None
+    try:
+        summary = json.loads(text)
+    except ValueError as exc:
+        raise RunDirError(f"{path}: damaged: not valid JSON ({exc}; {len(text)} bytes){again}") from None
+    problem = _summary_problem(summary)
+    if problem is not None:
+        raise RunDirError(f"{path}: {problem}")
+    return summary
 
 
 def dir_digest(run_dir):

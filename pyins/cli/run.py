@@ -102,22 +102,25 @@ def cmd_run(args):
 
 def cmd_report(args):
     if report.is_replay_dir(args.rundir):      # pyins replay's directory: its own page
+        summary = rundir.read_summary(args.rundir)
         path = report.render(args.rundir)
-        say(args, f"report: {path}")
-        emit_json(args, dict(report=path, complete=True))
+        complete = summary.get("complete") is not False
+        stopped = None if complete else (summary.get("warnings") or ["interrupted"])[0]
+        say(args, f"report: {path}" + ("" if complete else f"  [PARTIAL, {stopped}]"))
+        emit_json(args, dict(report=path, complete=complete, stopped=stopped, state=summary.get("state"),
+                             warnings=summary.get("warnings", [])))
         return EXIT_OK
-    if rundir.read_summary(args.rundir) is None:
-        what = ("the run stopped before it wrote its summary" if os.path.exists(
-            os.path.join(args.rundir, "resolved_scenario.json")) else "not a run directory")
-        raise InputError(f"{args.rundir}: {what} (no readable summary.json)")
+    rundir.summary_for_report(args.rundir)       # a damaged summary: one line naming it, before any phase
     with phase(phases(args), "report: reading the records"):
         summary, series = report.run.load(args.rundir)
     path = report.render(args.rundir, loaded=(summary, series), progress=phases(args))
     partial = not summary.get("complete")
+    for w in summary.get("report_warnings", []):
+        print(f"pyins report: WARNING: {w}", file=sys.stderr)
     say(args, f"report: {path}" + (f"  [PARTIAL, {summary.get('stopped', 'interrupted')}: the figures "
                                     "cover the ticks done]" if partial else ""))
     emit_json(args, dict(report=path, complete=not partial, stopped=summary.get("stopped"),
-                          variants=summary["variants"]))
+                          warnings=summary.get("report_warnings", []), variants=summary["variants"]))
     return EXIT_OK
 
 

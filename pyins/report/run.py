@@ -66,32 +66,68 @@ def _fill_facts(run_dir, summary, scn):
             v.setdefault(k, val)
 
 
+#: What a variant's timeseries.npz must hold for the figures
+_SERIES_KEYS = ("time_s", "north_m", "east_m", "horizontal_m", "vel_err_n_mps", "att_err_n_rad", "outputs")
+
+
 def load(run_dir):
     """summary.json and the variants' series. A partial run (Ctrl-C, a kill,
     or one being written) is read as far as its records go: each unfinished
     variant's records on disk beside the truth of the scenario the run was
     written from, its metrics computed here (summary.json is left as it is);
     ``summary["stopped"]`` says how it stands."""
-    summary = rundir.read_summary(run_dir)
-    if summary is None:
-        raise FileNotFoundError(f"{run_dir}: not a run directory (no readable {rundir.SUMMARY})")
+    summary = rundir.summary_for_report(run_dir)
+    problems = summary.setdefault("report_warnings", [])
     unfinished = [v for v in summary["variants"] if not v.get("complete")]
     scn = rundir.scenario_of(run_dir, summary) if unfinished else None
     specs = {spec.label: spec for spec in scn.runs()} if scn is not None else {}
     _fill_facts(run_dir, summary, scn)
-    series = {}
+    series, lost = {}, []
     for v in summary["variants"]:
-        path = os.path.join(run_dir, v["dir"], "timeseries.npz")
+        rel = os.path.join(v["dir"], "timeseries.npz")
+        path = os.path.join(run_dir, rel)
         spec = specs.get(v["label"])
         if not v.get("complete") and spec is not None:
-            res = rundir.load_written(run_dir, spec)
+            try:
+                res = rundir.load_written(run_dir, spec)
+            except (OSError, ValueError, KeyError, TypeError, IndexError) as exc:
+                problems.append(f"{os.path.join(v['dir'], 'records')}: unreadable ({type(exc).__name__}: "
+                                f"{exc}); variant {v['label']!r} is left out of the figures")
+                res = None
             if res is not None:
                 series[v["label"]] = records.timeseries(res)
                 v["ticks_done"] = int(res.outputs["tick"][-1])
                 v["metrics"] = metrics.run_metrics(spec, res)
         elif os.path.exists(path):
-            with np.load(path, allow_pickle=False) as z:
-                series[v["label"]] = {k: z[k] for k in z.files}
+            try:
+                with np.load(path, allow_pickle=False) as z:
+                    s = {k: z[k] for k in z.files}
+                missing = [k for k in _SERIES_KEYS if k not in s]
+                if missing:
+                    raise ValueError(f"no {', '.join(missing)}")
+                series[v["label"]] = s
+            except Exception as exc:    # noqa: BLE001 - any damage: a zip, a pickle, a short array
+                lost.append((v, rel, f"damaged ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''})"))
+        elif v.get("complete"):
+            lost.append((v, rel, "missing"))
+    if lost:        # a finished variant's series: rebuilt from its records when they and the scenario are there
+        scn = scn if scn is not None else rundir.scenario_of(run_dir, summary)
+        specs = {spec.label: spec for spec in scn.runs()} if scn is not None else {}
+        for v, rel, what in lost:
+            res = None
+            if v["label"] in specs:
+                try:
+                    res = rundir.load_written(run_dir, specs[v["label"]])
+                except (OSError, ValueError, KeyError, TypeError, IndexError):
+                    res = None
+            if res is not None and len(res.outputs):
+                series[v["label"]] = records.timeseries(res)
+                problems.append(f"{rel}: {what}; variant {v['label']!r} is drawn from its records instead")
+            else:
+                problems.append(f"{rel}: {what}, and its records cannot be read back; variant "
+                                f"{v['label']!r} is left out of the figures (its figures in the tables are "
+                                "summary.json's)")
     if unfinished:
         holder = records.is_locked(run_dir)
         if holder is not None:
@@ -405,7 +441,7 @@ def _results_tables(summary, series):
 def _caveats(summary):
     """Sentences on a run that is not the scenario as written: stopped, or
     run for another length (what the paper's figures then cannot be judged on)."""
-    out = []
+    out = [f"Not read: {w}." for w in summary.get("report_warnings", [])]
     if not summary["complete"]:
         out.append(f"PARTIAL ({summary.get('stopped', 'interrupted')}): the figures and tables cover the "
                    "ticks done; the paper's figures are not judged on a stopped variant.")

@@ -1,0 +1,119 @@
+"""The front door's defects as a careful user finds them (`pyins run`,
+`pyins report`, `pyins demo`, `pyins simulate`): bad input, interruptions,
+reuse and damaged files. Every case runs the command line as a user runs it
+(`pyins.__main__.main`) and checks the exit code and the one line it prints:
+never a silent wrong answer, never "internal error"."""
+import json
+import os
+import shutil
+
+import pytest
+
+from pyins import __main__ as cli
+
+#: A finished run of the cheapest built-in: seed003 for 36 s (two variants, 0.01 h)
+SHORT = ["seed003", "--hours", "0.01"]
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    out = tmp_path_factory.mktemp("finished") / "run"
+    assert cli.main(["run", *SHORT, "--out", str(out), "--quiet"]) == 0
+    return out
+
+
+def _files(root):
+    return sorted(os.path.relpath(os.path.join(d, f), root) for d, _, fs in os.walk(root) for f in fs)
+
+
+def _damage(path, how):
+    data = path.read_bytes()
+    if how == "truncate":
+        path.write_bytes(data[:len(data) // 2])
+    elif how == "corrupt":
+        b = bytearray(data)
+        for i in range(0, len(b), max(1, len(b) // 20)):
+            b[i] ^= 0x5A
+        path.write_bytes(bytes(b))
+    else:
+        path.unlink()
+
+
+def _report(capsys, d, *extra):
+    rc = cli.main(["report", str(d), *extra])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _files_of_a_finished_run():
+    # the layout of a seed003 run (every file it holds; the fixture checks it is the whole list)
+    top = ["comparison.png", "errors.png", "report.html", "resolved_scenario.json", "scenario.toml",
+           "summary.json", "table.png"]
+    per = ["records/checkpoint.json", "records/outputs.bin", "records/plant.bin", "records/records.json",
+           "timeseries.csv", "timeseries.npz"]
+    return top + [f"{v}/{f}" for v in ("no_rotation", "single-position_fwd_rev_seed_003") for f in per]
+
+
+def test_the_damage_list_is_every_file_of_a_run(finished):
+    assert _files(finished) == sorted(_files_of_a_finished_run())
+
+
+# ACCEPTANCE: "internal error" never appears on a damaged input file
+@pytest.mark.parametrize("how", ["truncate", "corrupt", "delete"])
+@pytest.mark.parametrize("rel", _files_of_a_finished_run())
+def test_report_of_a_damaged_run_directory_never_fails_inside(finished, tmp_path, capsys, rel, how):
+    d = tmp_path / "run"
+    shutil.copytree(finished, d)
+    _damage(d / rel, how)
+    rc, out, err = _report(capsys, d)
+    assert "internal error" not in err and "Traceback" not in err
+    assert rc in (0, 2), err
+    if rc == 2:
+        assert len(err.strip().splitlines()) == 1 and os.path.basename(rel) in err, err
+    elif rel.endswith("timeseries.npz") and how != "delete" or rel == "summary.json":
+        # what could not be read is said, on the command line and on the page
+        assert os.path.basename(rel) in err and "WARNING" in err, err
+        assert "timeseries.npz" in (d / "report.html").read_text()
+
+
+@pytest.mark.parametrize("text, says", [
+    ("[]", "not a run's summary"),
+    ("{}", "no 'variants'"),
+    ('{"variants": [1, 2], "title": "x", "scenario": "x", "digest": "x"}', "damaged 'variants'"),
+    ('{"format": 99, "variants": []}', "newer pyins"),
+    ('{"scenario": "seed 002", "ship_time_h": 2, "max_horizontal_error_m": 3}', "pyins demo"),
+])
+def test_report_of_a_summary_of_another_shape_names_it(finished, tmp_path, capsys, text, says):
+    d = tmp_path / "run"
+    shutil.copytree(finished, d)
+    (d / "summary.json").write_text(text)
+    rc, _, err = _report(capsys, d)
+    assert rc == 2 and "summary.json" in err and says in err and "internal error" not in err, err
+
+
+def test_report_of_a_damaged_summary_does_not_say_the_run_stopped(finished, tmp_path, capsys):
+    d = tmp_path / "run"
+    shutil.copytree(finished, d)
+    (d / "summary.json").write_text('{"variants": [')
+    rc, _, err = _report(capsys, d)
+    assert rc == 2 and "not valid JSON" in err and "stopped before" not in err, err
+    assert "--resume" in err and str(d) in err           # what can still be done, with the real directory
+
+
+def test_report_json_of_an_interrupted_replay_says_partial(tmp_path, capsys):
+    # item 6: a replay stopped by Ctrl-C writes complete=false, state=interrupted and a first warning
+    log = tmp_path / "imu.bin"
+    assert cli.main(["simulate", "demo", str(log), "--hours", "0.01", "--quiet"]) == 0
+    out = tmp_path / "rp"
+    assert cli.main(["replay", str(log), "--scenario", "demo", "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    s.update(complete=False, state="interrupted")
+    s.setdefault("warnings", []).insert(0, "interrupted (Ctrl-C) at 20 s after 2000 samples: the log was "
+                                           "not replayed to its end")
+    (out / "summary.json").write_text(json.dumps(s))
+    capsys.readouterr()
+    rc, text, _ = _report(capsys, out, "--json")
+    got = json.loads(text)
+    assert rc == 0 and got["complete"] is False and "interrupted" in got["stopped"]
+    rc, text, _ = _report(capsys, out)
+    assert rc == 0 and "PARTIAL" in text
