@@ -2,6 +2,7 @@
 against a reference, its page."""
 import os
 import sys
+import zipfile
 
 import numpy as np
 
@@ -90,6 +91,7 @@ _CLI_WORDS = (("pass fmt= one of", "give --format, one of"), ("fmt='binary'", "-
 
 def _cli_words(msg):
     import re
+    msg = re.sub(r"columns=\{'(\w+)': (?:NAME|\.\.\.)\}", r"--columns \1=NAME", msg)
     for python, cli in _CLI_WORDS:
         msg = msg.replace(python, cli)
     # the reader's option names in a list ("options ['time_col'] do not apply")
@@ -112,8 +114,14 @@ def _check_reader_options(args):
     for option, value in (("--lat", args.lat), ("--lon", args.lon), ("--height", args.height)):
         if value is not None and not np.isfinite(value):
             raise InputError(f"{option}: {value:g} is not a number")
-    if args.attitude is not None and not np.all(np.isfinite(args.attitude)):
-        raise InputError("--attitude: each of PITCH ROLL YAW must be a number of degrees")
+    if args.attitude is not None:
+        pitch, roll, yaw = args.attitude
+        if not (np.all(np.isfinite(args.attitude)) and abs(pitch) <= 90.0 and abs(roll) <= 360.0
+                and abs(yaw) <= 360.0):
+            raise InputError(f"--attitude {pitch:g} {roll:g} {yaw:g}: pitch must lie within +-90 deg, "
+                             "roll and yaw within +-360 deg")
+    if args.table_angle is not None and not abs(args.table_angle) <= 360.0:
+        raise InputError(f"--table-angle: {args.table_angle:g} deg is not within +-360 deg")
     if args.every is not None and args.every < 1:
         raise InputError(f"--every {args.every}: keep one record every 1 or more samples")
 
@@ -163,8 +171,10 @@ def cmd_replay(args):
     path, fmt, spooled = _spool(args.log, args.format)
     try:
         return _replay(args, path, fmt)
-    except (ValueError, InputError) as exc:
+    except (ValueError, InputError, EOFError, zipfile.BadZipFile) as exc:
         msg = _cli_words(str(exc))
+        if isinstance(exc, (EOFError, zipfile.BadZipFile)):      # an npz cut in a member
+            msg = f"{args.log}: not a complete file ({msg}): cut or damaged"
         if spooled is not None:
             msg = msg.replace(spooled, "standard input" if args.log == "-" else args.log)
         raise InputError(msg) from exc

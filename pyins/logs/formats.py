@@ -7,6 +7,8 @@ the project's own csv and npz are told apart here and read by
 import io as _io
 import os
 
+import zipfile
+
 import numpy as np
 
 from pyins.logs.files import _full, _lines, _opener, _read_bytes, _read_exact
@@ -352,8 +354,8 @@ def _parse_npz(path, name, opt):
     try:
         npz = np.load(_io.BytesIO(raw), allow_pickle=False)
         files = list(npz.files)
-    except (OSError, ValueError) as exc:
-        raise LogError(f"{name}: not a readable .npz file ({exc})") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise LogError(f"{name}: not a readable .npz file ({exc or 'empty'}): cut, damaged or not an npz") from None
     if opt.columns is None and all(k in files for k in _NPZ_KEYS):
         return None
     lower = {f.lower(): f for f in files}

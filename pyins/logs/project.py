@@ -19,6 +19,8 @@ import json
 import os
 from dataclasses import dataclass, field
 
+import zipfile
+
 import numpy as np
 
 CSV_COLUMNS = ("tick", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad",
@@ -94,8 +96,8 @@ def load_npz(path, file=None):
     name = os.fspath(path)
     try:
         npz = np.load(path if file is None else file, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"{name}: not a readable .npz file ({exc})") from exc
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{name}: not a readable .npz file ({exc or 'empty'}): cut, damaged or not an npz") from exc
     with npz:
         missing = [k for k in _NPZ_KEYS if k not in npz.files]
         if missing:

@@ -273,3 +273,35 @@ def test_what_it_prints_is_one_figure_and_names(tmp_path, log100, capsys):
     assert rc == 0, err
     assert "nothing compared" in out and "0.00 m" not in out and "coarse alignment, faults" in out, out
     assert "nothing compared" in (tmp_path / "a" / "report.html").read_text()
+
+
+# -- 23. bad values and bad logs: one line, exit 2 -----------------------------------------------------
+@pytest.mark.parametrize("extra, says", [
+    (["--attitude", "1e30", "0", "0"], "--attitude"),
+    (["--attitude", "100", "0", "0"], "--attitude"),
+    (["--table-angle", "1e30"], "--table-angle"),
+    (["--dt", "nan"], "--dt"),
+    (["--gyro-scale", "0"], "--gyro-scale"),
+    (["--coarse", "1e12"], "--coarse"),
+])
+def test_a_value_out_of_range_is_refused(tmp_path, log100, capsys, extra, says):
+    """Before: --attitude 1e30, --table-angle 1e30 ran (exit 0)."""
+    _refused(capsys, ["replay", str(log100), *SITE_ARGS, "--coarse", "40", "--out", str(tmp_path / "o"),
+                      "--quiet", *extra], says)
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04 cut"])
+def test_an_empty_or_cut_npz_is_refused_in_one_line(tmp_path, capsys, content):
+    """Before: "internal error EOFError" / "BadZipFile", exit 1."""
+    bad = tmp_path / "log.npz"
+    bad.write_bytes(content)
+    _refused(capsys, ["replay", str(bad), "--lat", "1", "--lon", "1", "--height", "0", "--coarse", "40",
+                      "--out", str(tmp_path / "o"), "--quiet"], "log.npz", "not a readable .npz")
+
+
+def test_an_npz_of_other_arrays_names_columns(tmp_path, capsys):
+    other = tmp_path / "other.npz"
+    np.savez(other, outputs=np.zeros(3))
+    line = _refused(capsys, ["replay", str(other), "--lat", "1", "--lon", "1", "--height", "0", "--coarse", "40",
+                             "--out", str(tmp_path / "o"), "--quiet"], "other.npz", "--columns gyro=NAME")
+    assert "columns={" not in line
