@@ -186,6 +186,11 @@ class _Summary:
         if fine is not None:
             summary["fine_alignment"] = fine
         summary["warnings"] = warnings(recs, aligning, hz)
+        if "aligned" in summary and abs(summary["aligned"]["roll_deg"]) > 90.0:
+            # gravity came out along the IMU's +z: an upside-down mounting, or axes declared wrong
+            summary["warnings"].append(
+                f"the alignment found the IMU upside down (roll {summary['aligned']['roll_deg']:.1f} deg): "
+                "if it was mounted upright, the log's axes are not the ones declared (--axes)")
         summary["navigating_records"] = self.navigating
         if self.spec is not None:
             summary["errors"] = dict(reference=f"the truth of {self.spec.scenario}",

@@ -94,6 +94,11 @@ def _cli_words(msg):
     msg = re.sub(r"columns=\{'(\w+)': (?:NAME|\.\.\.)\}", r"--columns \1=NAME", msg)
     for python, cli in _CLI_WORDS:
         msg = msg.replace(python, cli)
+    # the reader's keyword names: gyro_unit 'x' ... kind='increments', axes: ...
+    msg = re.sub(r"\b(gyro_unit|accel_unit|gyro_scale|accel_scale|time_col|table_angle)\b(?!')",
+                 lambda m: "--" + m.group(1).replace("_", "-"), msg)
+    msg = re.sub(r"\bkind='(\w+)'", r"--kind \1", msg)
+    msg = re.sub(r"(^|: )axes\b", r"\1--axes", msg)
     # the reader's option names in a list ("options ['time_col'] do not apply")
     return re.sub(r"options \[([^\]]*)\]", lambda m: "options " + ", ".join(
         "--" + k.strip(" '").replace("_", "-") for k in m.group(1).split(",")), msg)

@@ -305,3 +305,16 @@ def test_an_npz_of_other_arrays_names_columns(tmp_path, capsys):
     line = _refused(capsys, ["replay", str(other), "--lat", "1", "--lon", "1", "--height", "0", "--coarse", "40",
                              "--out", str(tmp_path / "o"), "--quiet"], "other.npz", "--columns gyro=NAME")
     assert "columns={" not in line
+
+
+def test_axes_declared_wrong_are_warned_and_reader_names_are_options(tmp_path, log100, capsys):
+    """Before: an FRD log read as RFU aligned upside down (roll -180 deg) with no
+    word; --gyro-unit bogus was named gyro_unit and kind='increments'."""
+    args = ["replay", str(log100), "--time-col", "first", "--lat", str(LAT), "--lon", str(LON), "--height", "0",
+            "--coarse", "40", "--out", str(tmp_path / "o"), "--quiet"]
+    rc, _, err = _run(args + ["--axes", "rfu"], capsys)
+    assert rc == 0 and "upside down" in err and "--axes" in err, err
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert any("upside down" in w for w in s["warnings"])
+    line = _refused(capsys, args + ["--axes", "frd", "--gyro-unit", "bogus"], "--gyro-unit 'bogus'", "--kind increments")
+    assert "gyro_unit" not in line and "kind=" not in line
