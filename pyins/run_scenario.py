@@ -22,11 +22,10 @@ import shutil
 import time
 
 from pyins import engine as engines
-from pyins import engine as engines
 from pyins import fil, metrics, records
 from pyins.metrics import group_metrics
 from pyins.progress import phase
-from pyins.rundir import (check_run_dir, hold_interrupts, load_variant, slug, variant_facts, write_summary,
+from pyins.rundir import (FORMAT, RunDirError, check_run_dir, read_summary, hold_interrupts, load_variant, slug, variant_facts, write_summary,
                           written_durations, written_ticks)
 from pyins.units import ARCMIN_TO_RAD
 
@@ -50,7 +49,7 @@ def _entry(spec, written):
 
 
 def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native", force=False,
-            notice=None):
+            notice=None, started=None):
     """Run every variant of ``scn`` (a pyins.scenario.Scenario) into
     ``run_dir``; returns the summary dict (also written to summary.json).
 
@@ -79,6 +78,8 @@ def execute(scn, run_dir, progress=None, resume=False, log=None, engine="native"
         with hold_interrupts() as held:
             lock = records.lock_dir(run_dir, notice=notice)
             summary, specs, resume = _start(scn, run_dir, resume, engine, force)
+        if started is not None:             # the directory taken: the caller's title line, after any refusal
+            started()
         return _variants(summary, specs, run_dir, progress, resume, log, engine,
                          KeyboardInterrupt() if held.interrupted else None)
     finally:
@@ -91,6 +92,13 @@ def _start(scn, run_dir, resume, engine, force):
     # 1. the run directory: refused if another's; the scenario as written and as resolved
     if check_run_dir(scn, run_dir, force) == "new":
         resume = False
+    old = read_summary(run_dir) if resume else None
+    if old is not None and old.get("engine", "native") != engine:
+        # refused before anything is written: the records on disk are the other engine's
+        raise RunDirError(f"{run_dir}: holds a run through --engine {old.get('engine', 'native')}; a resume "
+                          f"with --engine {engine} would be another run: resume with --engine "
+                          f"{old.get('engine', 'native')}, or run without --resume (it reruns every "
+                          "variant), or give another --out")
     src = scn.source if scn.source and os.path.exists(str(scn.source)) else None
     # the resolved scenario first: it names the run (its digest), so a kill after it
     # leaves a directory a resume recognises
@@ -101,7 +109,7 @@ def _start(scn, run_dir, resume, engine, force):
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
                    digest=scn.digest(), core_version=engines.core_version(), paper=scn.paper,
                    variants=[_entry(spec, written) for spec in specs], complete=False, state="running",
-                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name))
+                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name), format=FORMAT)
     if engine != "native":
         summary["engine"] = engine
     write_summary(run_dir, summary)
@@ -125,9 +133,8 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
                 if not resume and os.path.exists(vdir):
                     shutil.rmtree(vdir)
                 os.makedirs(vdir, exist_ok=True)
-                for name in ("timeseries.npz", "timeseries.csv"):      # derived: rewritten at the end
-                    if os.path.exists(os.path.join(vdir, name)):
-                        os.remove(os.path.join(vdir, name))
+                # a resumed variant's time series (derived) are rewritten, atomically, when it ends: a
+                # resume refused or stopped leaves a finished variant's as they were
                 checkpoint = int(round(CHECKPOINT_S / spec.dt))
                 bar = progress(spec.label) if progress else None
                 run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,

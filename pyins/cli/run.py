@@ -2,12 +2,13 @@
 directory, a run directory's page, and the set-up's main job."""
 import json
 import os
+import shlex
 import sys
 import time
 
 import numpy as np
 
-from pyins import engine, metrics, open_loop, report, run_scenario, rundir, scenario, sim
+from pyins import engine, metrics, open_loop, records, report, run_scenario, rundir, scenario, sim
 from pyins.progress import phase
 from pyins.report.paper import paper_rows
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
@@ -51,7 +52,8 @@ def add_demo(cmd):
     p.add_argument("--sensors", default="seed002",
                       help="sensor error preset: error_free, seed000, seed001, seed002, seed003")
     p.add_argument("--seed", type=int, default=1, help="noise seed")
-    p.add_argument("--out", default=os.path.join("runs", "demo"), help="output directory")
+    p.add_argument("--out", default=os.path.join("runs", "setup_demo"),
+                   help="output directory (default runs/setup_demo: `pyins run demo` writes runs/demo)")
 
 
 def _summary_lines(summary):
@@ -73,6 +75,22 @@ def _summary_lines(summary):
     return out
 
 
+def _resume_command(args, out):
+    """The command that continues this run: the same scenario and overrides, --out, --resume."""
+    words = ["pyins", "run", args.scenario, "--out", out]
+    if args.hours is not None:
+        words += ["--hours", f"{args.hours:g}"]
+    if args.seed is not None:
+        words += ["--seed", str(args.seed)]
+    for item in args.set or []:
+        words += ["--set", item]
+    if getattr(args, "variant", None) is not None:
+        words += ["--variant", str(args.variant)]
+    if args.engine != "native":
+        words += ["--engine", args.engine]
+    return " ".join(shlex.quote(w) for w in words + ["--resume"])
+
+
 def cmd_run(args):
     scn = scenario.load(args.scenario)
     overrides = set_overrides(args)
@@ -81,16 +99,16 @@ def cmd_run(args):
     if overrides:
         scn = scn.with_overrides(overrides)
     out = args.out or default_out(scn.name)
-    say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
     try:
         summary = run_scenario.execute(scn, out, progress=progress_bars(args), resume=args.resume,
                                log=None if args.quiet or args.json else print, engine=args.engine,
                                force=getattr(args, "force", False),
-                               notice=lambda text: print(f"pyins run: note: {text}", file=sys.stderr))
+                               notice=lambda text: print(f"pyins run: note: {text}", file=sys.stderr),
+                               started=lambda: say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}"))
     except KeyboardInterrupt:
         # no metrics or plots now (they can take longer than the user waits): the report reads the records
-        print(f"\npyins run: interrupted; the partial result is in {out}: `pyins report {out}` renders "
-              f"it, `pyins run ... --out {out} --resume` continues it", file=sys.stderr)
+        print(f"\npyins run: interrupted; the partial result is in {out}: `pyins report {shlex.quote(out)}` "
+              f"renders it, `{_resume_command(args, out)}` continues it", file=sys.stderr)
         return EXIT_INTERRUPTED
     path = report.render(out, progress=phases(args))
     for line in _summary_lines(summary):
@@ -129,6 +147,10 @@ def cmd_demo(args):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    held = rundir.read_summary(args.out)
+    if isinstance(held, dict) and "variants" in held:
+        raise InputError(f"--out {args.out}: holds a `pyins run` of {held.get('scenario')!r}; the demo "
+                         "would overwrite its summary.json: give another --out")
     motion = sim.HeadingSwing.experiment(1)
     sensors = sim.SensorModel(sim.preset(args.sensors), seed=args.seed)
     ticks = int(round(args.hours * TICKS_PER_HOUR))
@@ -178,8 +200,7 @@ def cmd_demo(args):
     fig.tight_layout()
     plot = os.path.join(args.out, "navigation_errors.png")
     fig.savefig(plot, dpi=100)
-    with open(os.path.join(args.out, "summary.json"), "w") as f:
-        json.dump(summary, f, indent=2)
+    records.write_atomic(os.path.join(args.out, "summary.json"), json.dumps(summary, indent=2))
     print(f"pyins demo: {args.hours:g} h of ship time through the C++ firmware in {wall:.1f} s wall")
     print(f"  max horizontal position error {summary['max_horizontal_error_m']:.1f} m "
           f"({summary['max_horizontal_error_nmi']:.3f} nmi), final {summary['final_horizontal_error_m']:.1f} m")

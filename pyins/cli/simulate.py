@@ -1,4 +1,6 @@
 """`pyins simulate`: a scenario's IMU log written as a field log would be."""
+import sys
+
 import numpy as np
 
 from pyins import logs, scenario, sim
@@ -22,10 +24,35 @@ def add_simulate(cmd):
     p.add_argument("--variant", type=int, default=0, help="which [compare] variant (default 0)")
 
 
+def _load_for_a_log(name, hours):
+    """The scenario, with --hours; a [firmware] key the loader refuses (an
+    alignment longer than the run, ...) is left out, as the log does not use
+    the firmware: (Scenario, [notes on what was ignored])."""
+    import tomllib
+    text, path = scenario.read_toml_source(name, scenario.builtin_path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return scenario.load(name), []          # its own one-line error
+    if hours is not None:
+        data["duration"] = f"{hours} h"
+    notes = []
+    for _ in range(len(data.get("firmware", {})) + 1):
+        try:
+            return scenario.Scenario(text, data, str(path), path.stem), notes
+        except scenario.ScenarioError as exc:
+            section, _, key = exc.key.partition(".")
+            if section != "firmware" or key not in data.get("firmware", {}):
+                raise
+            del data["firmware"][key]
+            notes.append(f"{exc.key} ignored: the IMU log does not use the firmware ({exc.reason})")
+    return scenario.Scenario(text, data, str(path), path.stem), notes
+
+
 def cmd_simulate(args):
-    scn = scenario.load(args.scenario)
-    if args.hours is not None:
-        scn = scn.with_overrides({"duration": f"{args.hours} h"})
+    scn, notes = _load_for_a_log(args.scenario, args.hours)
+    for note in notes:
+        print(f"pyins simulate: note: {note}", file=sys.stderr)
     specs = list(scn.runs())
     if not 0 <= args.variant < len(specs):
         raise InputError(f"--variant {args.variant}: {scn.name} has {len(specs)} variant(s) (0..{len(specs) - 1})")
@@ -37,7 +64,7 @@ def cmd_simulate(args):
     alpha0 = float(spec.config.get("table_angle_rad", 0.0))
     sensors = sim.SensorModel(spec.errors, seed=spec.seed)
     fmt = logs.format_of(args.log, args.format)
-    metadata = dict(scenario=scn.text, scenario_name=scn.name, variant=args.variant, digest=scn.digest())
+    metadata = dict(scenario=scn.text, notes=notes, scenario_name=scn.name, variant=args.variant, digest=scn.digest())
     # written as the chunks come (bounded memory); the file appears under its name when complete
     n = 0
     with logs.LogWriter(args.log, fmt, dt=spec.dt, metadata=metadata) as log:
@@ -50,5 +77,5 @@ def cmd_simulate(args):
     say(args, f"pyins simulate {scn.name} [{spec.label}]: {n} samples "
                f"({n * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
     emit_json(args, dict(log=args.log, format=fmt, samples=n, scenario=scn.name,
-                          variant=spec.label))
+                          variant=spec.label, notes=notes))
     return EXIT_OK

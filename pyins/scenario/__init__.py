@@ -242,6 +242,12 @@ def read_toml_source(path_or_name, builtin):
     """(text, path) of a .toml file, or of the built-in ``builtin(name)``
     returns the path of; unreadable files raise ScenarioError."""
     path = Path(path_or_name)
+    if path.is_dir():
+        run = (path / "summary.json").exists() or (path / "resolved_scenario.json").exists()
+        raise ScenarioError("a directory, not a scenario file" + (
+            f" (a run directory: `pyins report {path_or_name}` renders it, `pyins run SCENARIO --out "
+            f"{path_or_name} --resume` continues it)" if run else ": give a .toml file or a built-in name "
+            "(pyins list)"), "", str(path_or_name))
     if not path.is_file():
         path = builtin(str(path_or_name))
     try:

@@ -127,8 +127,10 @@ def _convert(raw, key, where):
     if key.shape == 3:
         if isinstance(raw, list):
             if len(raw) != 3:
-                raise ScenarioError(f"must be one value for all three axes or a list of 3, got "
-                                    f"{len(raw)} values", where)
+                # a lever arm is a vector: one value for all three axes is refused where it is resolved
+                forms = ("a list of 3 lengths [x starboard, y bow, z up]" if key.kind == "length"
+                         else "one value for all three axes or a list of 3")
+                raise ScenarioError(f"must be {forms}, got {len(raw)} values", where)
             return [_scalar(v, key, f"{where}[{i}]") for i, v in enumerate(raw)]
         return [_scalar(raw, key, where)] * 3
     # a 3x3 matrix with a zero diagonal

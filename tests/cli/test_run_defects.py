@@ -117,3 +117,84 @@ def test_report_json_of_an_interrupted_replay_says_partial(tmp_path, capsys):
     assert rc == 0 and got["complete"] is False and "interrupted" in got["stopped"]
     rc, text, _ = _report(capsys, out)
     assert rc == 0 and "PARTIAL" in text
+
+
+def _run(capsys, *argv):
+    rc = cli.main(["run", *argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_resume_with_another_engine_is_refused_before_touching_the_run(finished, tmp_path, capsys):
+    # item 13: it deleted the finished run's time series, marked the summary running, then refused
+    d = tmp_path / "run"
+    shutil.copytree(finished, d)
+    before = {f: (d / f).read_bytes() for f in _files(d) if not f.endswith((".png", ".html"))}
+    rc, out, err = _run(capsys, *SHORT, "--out", str(d), "--resume", "--engine", "reference")
+    assert rc == 2 and "--engine native" in err and "--engine reference" in err, err
+    assert "pyins run seed003" not in out           # refused first: no title line, no "-> DIR"
+    assert {f: (d / f).read_bytes() for f in before} == before
+
+
+def test_run_of_a_directory_says_it_is_one(finished, tmp_path, capsys):
+    # item 18: "no such file or built-in scenario"
+    rc, _, err = _run(capsys, str(finished))
+    assert rc == 2 and "a directory" in err and f"pyins report {finished}" in err and "--resume" in err, err
+    rc, _, err = _run(capsys, str(tmp_path))
+    assert rc == 2 and "a directory" in err and "no such file" not in err, err
+
+
+def test_a_lever_arm_message_offers_only_what_is_accepted(tmp_path, capsys):
+    # item 19: two components were answered with "one value for all three axes", which a single
+    # length then refuses; both messages now ask for the list of 3
+    for value in ('["0.5 m", "1 m"]', '"0.5 m"'):
+        f = tmp_path / "lever.toml"
+        f.write_text(f'title = "x"\nduration = "60 s"\n[motion]\nkind = "static"\nlever_b = {value}\n')
+        rc, _, err = _run(capsys, str(f), "--out", str(tmp_path / "out"))
+        assert rc == 2 and "motion.lever_b" in err and "list of 3" in err, err
+        assert "one value for all three" not in err, err
+
+
+def test_a_refused_run_prints_no_title(finished, tmp_path, capsys):
+    d = tmp_path / "mine"
+    d.mkdir()
+    (d / "notes.txt").write_text("mine")
+    rc, out, err = _run(capsys, *SHORT, "--out", str(d))
+    assert rc == 2 and "not a pyins run directory" in err and out == "", (out, err)
+    assert (d / "notes.txt").read_text() == "mine"
+
+
+def test_demo_and_run_demo_do_not_share_a_directory(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["demo", "--hours", "0.01", "--quiet"]) == 0
+    assert cli.main(["run", "demo", "--hours", "0.01", "--quiet"]) == 0
+    capsys.readouterr()
+    rc, _, err = _report(capsys, tmp_path / "runs" / "demo")
+    assert rc == 0, err
+    # and the demo never overwrites a run's summary
+    rc = cli.main(["demo", "--hours", "0.01", "--out", str(tmp_path / "runs" / "demo")])
+    assert rc == 2 and "pyins run" in capsys.readouterr().err
+
+
+def test_the_ctrl_c_line_prints_the_real_resume_command(tmp_path, capsys, monkeypatch):
+    from pyins import run_scenario
+
+    def stop(*a, **k):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(run_scenario, "execute", stop)
+    d = tmp_path / "x"
+    rc, _, err = _run(capsys, *SHORT, "--out", str(d), "--set", "seed=4")
+    assert rc == 130
+    assert f"pyins run seed003 --out {d} --hours 0.01 --set seed=4 --resume" in err, err
+    assert "..." not in err
+
+
+def test_simulate_ignores_a_firmware_key_it_does_not_use_and_says_so(tmp_path, capsys):
+    # item 22: refused for "firmware.fine_time: the alignment is longer than the duration"
+    f = tmp_path / "s.toml"
+    f.write_text('title = "x"\nduration = "60 s"\n[motion]\nkind = "static"\n[firmware]\nfine_time = "100 s"\n')
+    rc = cli.main(["simulate", str(f), str(tmp_path / "imu.bin"), "--json"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    assert "firmware.fine_time" in err and "ignored" in err
+    assert any("firmware.fine_time" in n for n in json.loads(out)["notes"])     # kept in what it prints
