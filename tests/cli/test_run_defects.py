@@ -198,3 +198,16 @@ def test_simulate_ignores_a_firmware_key_it_does_not_use_and_says_so(tmp_path, c
     assert rc == 0, err
     assert "firmware.fine_time" in err and "ignored" in err
     assert any("firmware.fine_time" in n for n in json.loads(out)["notes"])     # kept in what it prints
+
+
+def test_paper_notes_hold_no_figure_of_ours(tmp_path, capsys):
+    # item 12: "(ours 1.039')" beside a run with other sensor errors whose table said 0.0035'
+    d = tmp_path / "run"
+    assert cli.main(["run", *SHORT, "--set", "sensors.gyro_bias=0.003deg/h", "--out", str(d), "--quiet"]) == 0
+    page = (d / "report.html").read_text()
+    assert "ours 1.039" not in page and "ours 0.185" not in page
+    import re
+    from pyins import scenario
+    for name, _ in scenario.list_builtin():
+        for f in (scenario.load(name).paper or {}).get("figures", []):
+            assert not re.search(r"\bours\b[^.;:]*\d", f.get("note") or ""), (name, f["note"])

@@ -218,7 +218,7 @@ MISTAKES = [
     ("lever component", 'lever_b = ["150 m", "0 m", "0 m"]\n', "motion.lever_b[0]",
      "out of range: '150 m' must be >= -100 m and <= 100 m"),
     ("lever not a list", 'lever_b = "1 m"\n', "motion.lever_b", "must be a list of 3 lengths"),
-    ("lever of 2", 'lever_b = ["1 m", "1 m"]\n', "motion.lever_b", "a list of 3, got 2 values"),
+    ("lever of 2", 'lever_b = ["1 m", "1 m"]\n', "motion.lever_b", "a list of 3 lengths [x starboard, y bow, z up], got 2 values"),
     ("lever_p and the plant", 'lever_p = ["0.1 m", "0 m", "0 m"]\n', "motion.lever_p",
      "lever_p is not supported by the compiled FIL plant yet"),
     ("spectrum and heave", 'heave = [{ amplitude = "1 m", period = "8 s" }]\n'
