@@ -95,6 +95,9 @@ def _cli_words(msg):
     for python, cli in _CLI_WORDS:
         msg = msg.replace(python, cli)
     # the reader's keyword names: gyro_unit 'x' ... kind='increments', axes: ...
+    msg = re.sub(r"\b(gyro_unit|accel_unit)='([^']*)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", msg)
+    msg = msg.replace(" and kind", " and --kind").replace(
+        " (plausibility=False for a log without gravity)", " (the check needs gravity in the log)")
     msg = re.sub(r"\b(gyro_unit|accel_unit|gyro_scale|accel_scale|time_col|table_angle)\b(?!')",
                  lambda m: "--" + m.group(1).replace("_", "-"), msg)
     msg = re.sub(r"\bkind='(\w+)'", r"--kind \1", msg)
@@ -127,8 +130,8 @@ def _check_reader_options(args):
                              "roll and yaw within +-360 deg")
     if args.table_angle is not None and not abs(args.table_angle) <= 360.0:
         raise InputError(f"--table-angle: {args.table_angle:g} deg is not within +-360 deg")
-    if args.every is not None and args.every < 1:
-        raise InputError(f"--every {args.every}: keep one record every 1 or more samples")
+    if args.every is not None and not 1 <= args.every <= replay_options.MAX_TICKS:
+        raise InputError(f"--every {args.every}: keep one record every 1 to {replay_options.MAX_TICKS} samples")
 
 
 def _spool(log, fmt):

@@ -283,9 +283,11 @@ def test_what_it_prints_is_one_figure_and_names(tmp_path, log100, capsys):
     (["--dt", "nan"], "--dt"),
     (["--gyro-scale", "0"], "--gyro-scale"),
     (["--coarse", "1e12"], "--coarse"),
+    (["--every", "99999999999999999999"], "--every"),
 ])
 def test_a_value_out_of_range_is_refused(tmp_path, log100, capsys, extra, says):
-    """Before: --attitude 1e30, --table-angle 1e30 ran (exit 0)."""
+    """Before: --attitude 1e30, --table-angle 1e30 ran (exit 0); --every 1e20 was an
+    internal error (OverflowError)."""
     _refused(capsys, ["replay", str(log100), *SITE_ARGS, "--coarse", "40", "--out", str(tmp_path / "o"),
                       "--quiet", *extra], says)
 
@@ -318,3 +320,12 @@ def test_axes_declared_wrong_are_warned_and_reader_names_are_options(tmp_path, l
     assert any("upside down" in w for w in s["warnings"])
     line = _refused(capsys, args + ["--axes", "frd", "--gyro-unit", "bogus"], "--gyro-unit 'bogus'", "--kind increments")
     assert "gyro_unit" not in line and "kind=" not in line
+
+
+def test_a_log_without_gravity_names_options_only(tmp_path, log100, capsys):
+    """Before: "check accel_unit and kind (plausibility=False ...)": Python names,
+    and a way out the command line does not have."""
+    line = _refused(capsys, ["replay", str(log100), "--axes", "frd", "--time-col", "none", "--rate", "100000",
+                             "--lat", str(LAT), "--lon", str(LON), "--height", "0", "--coarse", "40", "--out",
+                             str(tmp_path / "o"), "--quiet"], "--accel-unit", "--kind")
+    assert "plausibility" not in line and "accel_unit" not in line
