@@ -167,7 +167,8 @@ class _Summary:
 
     def summary(self, log_path, samples, every):
         cfg, hz, recs = self.cfg, self.hz, self.last
-        summary = dict(log=os.path.abspath(log_path) if log_path else None, samples=int(samples),
+        log = "standard input" if log_path == "-" else os.path.abspath(log_path) if log_path else None
+        summary = dict(log=log, samples=int(samples),
                        rate_hz=int(hz), every=every,
                        final=dict(lat_deg=float(np.degrees(recs["lat_rad"][-1])),
                                   lon_deg=float(np.degrees(recs["lon_rad"][-1])),

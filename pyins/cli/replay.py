@@ -244,7 +244,7 @@ def _replay(args, path, fmt):
     bar = bar(f"replaying {args.log}") if bar is not None and data.n else None
     try:
         summary = replay.replay(blocks, cfg, out_dir, every=every, spec=truth_of, engine=args.engine,
-                                log_path=None if args.log == "-" else args.log, reference=reference,
+                                log_path=args.log, reference=reference,
                                 t_first=data.metadata.get("t_first"), notes=notes,
                                 progress=None if bar is None else (lambda done: bar(min(done, data.n), data.n)))
     except KeyboardInterrupt:
@@ -255,7 +255,7 @@ def _replay(args, path, fmt):
             print("\npyins replay: interrupted before the first record: nothing written", file=sys.stderr)
         return EXIT_INTERRUPTED
     page = report.render(out_dir)
-    say(args, f"pyins replay {args.log}: {summary['samples']} samples at {hz} Hz "
+    say(args, f"pyins replay {'standard input' if args.log == '-' else args.log}: {summary['samples']} samples at {hz} Hz "
                f"-> {out_dir}/navigation.npz")
     if "aligned" in summary:
         al = summary["aligned"]

@@ -253,6 +253,7 @@ def test_a_log_from_a_pipe_or_stdin_replays_as_the_file(tmp_path, log100):
         assert r.returncode == 0, r.stderr
         got = json.loads(r.stdout)
         assert got["final"] == want["final"] and got["samples"] == want["samples"]
+        assert got["log"] == ("standard input" if src == "-" else "/dev/stdin")
     r = subprocess.run(f"cat {log100} | {sys.executable} -m pyins replay - {' '.join(SITE_ARGS)} --coarse 40 "
                        f"--out {tmp_path / 'p'} --quiet", shell=True, capture_output=True, text=True)
     assert r.returncode == 2 and "standard input" in r.stderr and "--format" in r.stderr, r.stderr
