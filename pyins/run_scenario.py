@@ -109,7 +109,8 @@ def _start(scn, run_dir, resume, engine, force):
     summary = dict(scenario=scn.name, title=scn.title, source=str(scn.source) if src else scn.source,
                    digest=scn.digest(), core_version=engines.core_version(), paper=scn.paper,
                    variants=[_entry(spec, written) for spec in specs], complete=False, state="running",
-                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name), format=FORMAT)
+                   scenario_data=scn.data, scenario_stem=getattr(scn, "_stem", scn.name), format=FORMAT,
+                   notes=list(getattr(scn, "notes", [])))
     if engine != "native":
         summary["engine"] = engine
     write_summary(run_dir, summary)

@@ -33,6 +33,8 @@ def add_run(cmd):
     p.add_argument("--hours", type=float, help="override the duration [h]")
     p.add_argument("--seed", type=int, help="override the noise seed")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scenario key (repeatable)")
+    p.add_argument("--variant", type=int, metavar="N",
+                   help="run only [compare] variant N (0 = the first; default: every variant)")
     p.add_argument("--resume", action="store_true", help="continue an interrupted run in --out")
     p.add_argument("--force", action="store_true", help="replace a run of another scenario in --out")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
@@ -98,13 +100,20 @@ def cmd_run(args):
         overrides["seed"] = args.seed
     if overrides:
         scn = scn.with_overrides(overrides)
+    if args.variant is not None:
+        scn = scn.only_variant(args.variant)
     out = args.out or default_out(scn.name)
+
+    def started():
+        say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
+        for note in scn.notes:
+            print(f"pyins run: note: {note}", file=sys.stderr)
     try:
         summary = run_scenario.execute(scn, out, progress=progress_bars(args), resume=args.resume,
                                log=None if args.quiet or args.json else print, engine=args.engine,
                                force=getattr(args, "force", False),
                                notice=lambda text: print(f"pyins run: note: {text}", file=sys.stderr),
-                               started=lambda: say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}"))
+                               started=started)
     except KeyboardInterrupt:
         # no metrics or plots now (they can take longer than the user waits): the report reads the records
         print(f"\npyins run: interrupted; the partial result is in {out}: `pyins report {shlex.quote(out)}` "

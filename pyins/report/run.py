@@ -442,6 +442,7 @@ def _caveats(summary):
     """Sentences on a run that is not the scenario as written: stopped, or
     run for another length (what the paper's figures then cannot be judged on)."""
     out = [f"Not read: {w}." for w in summary.get("report_warnings", [])]
+    out += [f"Note: {n}." for n in summary.get("notes", [])]
     if not summary["complete"]:
         out.append(f"PARTIAL ({summary.get('stopped', 'interrupted')}): the figures and tables cover the "
                    "ticks done; the paper's figures are not judged on a stopped variant.")

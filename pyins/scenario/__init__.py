@@ -87,6 +87,7 @@ class Scenario:
         self.data = data
         self.source = source
         self._stem = stem
+        self.notes = []         #: what an override changed beyond its key ([compare] collapsed, figures left out)
         try:
             self._base = _resolve(data, stem)
             self._compare, self._variants = self._resolve_compare(data)
@@ -208,12 +209,62 @@ class Scenario:
         """
         data = copy.deepcopy(self.data)
         where = f"{self.source} (with overrides)"
+        notes = list(getattr(self, "notes", []))
+        cmp = data.get("compare") if isinstance(data.get("compare"), dict) else None
         for path, value in overrides.items():
+            if cmp is not None and path == cmp.get("key") and isinstance(cmp.get("values"), list):
+                # the value given wins over [compare]'s: one variant, under its label when it is one of them
+                values, labels = cmp["values"], cmp.get("labels")
+                label = (labels[values.index(value)] if value in values and isinstance(labels, list)
+                         and len(labels) == len(values) else f"{path} = {value}")
+                cmp.update(values=[value], labels=[label])
+                notes.append(f"{path} = {value!r} replaces [compare], which varied it over "
+                             f"{', '.join(map(str, values))}: one run, {label!r}")
+            elif cmp is not None and path == "compare.values" and "compare.labels" not in overrides:
+                cmp.pop("labels", None)        # the file's labels are for its values
             try:
                 _set_key(data, path, value)
             except ScenarioError as exc:
                 raise exc.with_source(where) from None
-        return Scenario(self.text, data, where, self._stem)
+        _drop_figures_of_variants_not_run(data, notes)
+        scn = Scenario(self.text, data, where, self._stem)
+        scn.notes = notes
+        return scn
+
+    def only_variant(self, n, option="--variant"):
+        """The scenario with only its [compare] variant ``n`` (its label and
+        paper figures kept); ScenarioError naming ``option`` when there is none."""
+        labels = self.labels
+        if not 0 <= n < len(labels):
+            raise ScenarioError(f"{option} {n}: {self.name} has {len(labels)} variant(s) "
+                                f"(0..{len(labels) - 1})", "", self.source)
+        if self._compare is None:
+            return self
+        data = copy.deepcopy(self.data)
+        data["compare"].update(values=[self._compare["values"][n]], labels=[labels[n]])
+        notes = list(getattr(self, "notes", []))
+        _drop_figures_of_variants_not_run(data, notes)
+        scn = Scenario(self.text, data, f"{self.source} (variant {n})", self._stem)
+        scn.notes = notes + [f"{option} {n}: only the variant {labels[n]!r} of [compare] is run"]
+        return scn
+
+
+def _drop_figures_of_variants_not_run(data, notes):
+    """[paper] figures of variants an override took out of [compare] leave
+    the scenario (a note says which)."""
+    cmp = data.get("compare") if isinstance(data.get("compare"), dict) else None
+    paper = data.get("paper") if isinstance(data.get("paper"), dict) else None
+    if cmp is None or paper is None or not isinstance(paper.get("figures"), list):
+        return
+    labels = cmp.get("labels")
+    if not isinstance(labels, list):
+        labels = [f"{cmp.get('key')} = {v}" for v in cmp.get("values", [])]
+    keep = [f for f in paper["figures"] if not isinstance(f, dict) or f.get("variant") in (None, *labels)]
+    gone = sorted({f.get("variant") for f in paper["figures"] if f not in keep})
+    if gone:
+        paper["figures"] = keep
+        notes.append(f"the paper's figures of {', '.join(map(repr, gone))} are not shown: that run is not "
+                     "made")
 
 
 def loads(text, source="<string>", name=None):

@@ -211,3 +211,35 @@ def test_paper_notes_hold_no_figure_of_ours(tmp_path, capsys):
     for name, _ in scenario.list_builtin():
         for f in (scenario.load(name).paper or {}).get("figures", []):
             assert not re.search(r"\bours\b[^.;:]*\d", f.get("note") or ""), (name, f["note"])
+
+
+def _labels(d):
+    return [v["label"] for v in json.loads((d / "summary.json").read_text())["variants"]]
+
+
+def test_set_on_the_compared_key_wins_and_says_so(tmp_path, capsys):
+    # item 8: --set indexing.scheme=... printed the four default variants' figures
+    d = tmp_path / "run"
+    rc, _, err = _run(capsys, "seed002_exp1", "--hours", "0.005", "--set", "indexing.scheme=heading_isolation",
+                      "--out", str(d), "--quiet")
+    assert rc == 0, err
+    assert _labels(d) == ["indexing.scheme = heading_isolation"]
+    assert "[compare]" in err and "indexing.scheme" in err
+    s = json.loads((d / "summary.json").read_text())
+    assert any("[compare]" in n for n in s["notes"])                 # kept in the summary
+    assert "replaces [compare]" in (d / "report.html").read_text()   # and on the page
+    # compare.values with the file's [paper] labels for other values: the labels follow the values
+    d2 = tmp_path / "run2"
+    rc, _, err = _run(capsys, "seed002_exp1", "--hours", "0.005", "--set", 'compare.values=["none", "two_position"]',
+                      "--out", str(d2), "--quiet")
+    assert rc == 0, err
+    assert _labels(d2) == ["indexing.scheme = none", "indexing.scheme = two_position"]
+
+
+def test_run_variant_runs_one_variant_with_its_label(tmp_path, capsys):
+    d = tmp_path / "run"
+    rc, _, err = _run(capsys, "seed002_exp1", "--hours", "0.005", "--variant", "1", "--out", str(d), "--quiet")
+    assert rc == 0, err
+    assert _labels(d) == ["traditional two-position"]
+    rc, _, err = _run(capsys, "seed002_exp1", "--variant", "4", "--out", str(tmp_path / "x"))
+    assert rc == 2 and "--variant 4" in err and "0..3" in err, err
