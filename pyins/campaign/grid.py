@@ -133,6 +133,10 @@ def parse_overrides(items):
     return out
 
 
+#: The most seeds a campaign takes (each is at least one run; more is a typo, not a plan)
+MAX_SEEDS = 100_000
+
+
 def parse_seeds(seeds, where, source):
     """None, a count N (0..N-1), a list, or text ("5", "0,3,7", "2..6")."""
     if seeds is None:
@@ -142,10 +146,14 @@ def parse_seeds(seeds, where, source):
         if ".." in s:
             a, _, b = s.partition("..")
             try:
-                seeds = list(range(int(a), int(b) + 1))
+                first, last = int(a), int(b)
             except ValueError:
                 raise ScenarioError(f"{seeds!r}: write a count, a list or FIRST..LAST", where,
                                     source) from None
+            if last - first + 1 > MAX_SEEDS:
+                raise ScenarioError(f"out of range: {seeds!r} is {last - first + 1} seeds, more than "
+                                    f"{MAX_SEEDS} runs", where, source)
+            seeds = list(range(first, last + 1))
         elif "," in s:
             seeds = [parse_value(v) for v in s.split(",")]
         else:
@@ -155,6 +163,8 @@ def parse_seeds(seeds, where, source):
     if isinstance(seeds, int):
         if seeds < 1:
             raise ScenarioError(f"out of range: a count of seeds must be >= 1, got {seeds}", where, source)
+        if seeds > MAX_SEEDS:
+            raise ScenarioError(f"out of range: {seeds} seeds is more than {MAX_SEEDS} runs", where, source)
         return list(range(seeds))
     if not isinstance(seeds, (list, tuple)) or not seeds:
         raise ScenarioError(f"must be a count or a non-empty list of seeds, got {seeds!r}", where, source)

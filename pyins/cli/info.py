@@ -2,7 +2,7 @@
 fast the core runs here, which core is loaded."""
 from pyins import __version__, bench, campaign, engine, logs, scenario, sim
 
-from .common import EXIT_OK, emit_json
+from .common import EXIT_OK, InputError, emit_json
 
 
 #: The examples each subcommand's --help ends with.
@@ -53,7 +53,14 @@ def cmd_list(args):
     return EXIT_OK
 
 
+#: The longest --seconds of pyins bench (each of its figures takes about that long)
+BENCH_MAX_S = 600.0
+
+
 def cmd_bench(args):
+    if not 0 < args.seconds <= BENCH_MAX_S:       # NaN too
+        raise InputError(f"--seconds {args.seconds:g}: must be more than 0 and at most {BENCH_MAX_S:g} "
+                         f"(the time budget of each figure)")
     fig = bench.run(seconds=args.seconds)
     if args.json:
         emit_json(args, fig)
