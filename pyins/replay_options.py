@@ -96,6 +96,10 @@ def ticks_of(option, seconds, hz, zero=None):
     if seconds == 0 and zero is None:
         raise OptionError(f"{option}: 0 s is not an interval: give at least one tick "
                           f"({1.0 / hz:g} s at {hz} Hz), or leave {option} out for the default")
+    if ticks > 0 and abs(ticks - seconds * hz) > 1e-6:
+        lo, hi = np.floor(seconds * hz), np.ceil(seconds * hz)
+        raise OptionError(f"{option}: {seconds:g} s is not a whole number of ticks at {hz} Hz (a tick is "
+                          f"{1.0 / hz:g} s): give {lo / hz:g} s or {hi / hz:g} s")
     if ticks == 0 and seconds > 0:
         way = f"0 for {zero}, or at least" if zero else "at least"
         raise OptionError(f"{option}: {seconds:g} s rounds to 0 ticks at {hz} Hz (a tick is "

@@ -60,6 +60,7 @@ def _refused(capsys, argv, *says):
     (["--attitude", "0", "0", "-90.8", "--coarse", "0.004"], ["--coarse", "rounds to 0 ticks"]),
     (["--coarse", "40", "--fine", "0.001"], ["--fine", "rounds to 0 ticks"]),
     (["--coarse", "40", "--every", "0"], ["--every 0"]),
+    (["--coarse", "40.005"], ["--coarse", "40.005 s is not a whole number of ticks at 100 Hz", "40 s or 40.01 s"]),
     (["--coarse", "40", "--every", "-3"], ["--every -3"]),
 ])
 def test_a_time_that_rounds_to_zero_ticks_is_refused(tmp_path, log100, capsys, extra, says):
