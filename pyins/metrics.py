@@ -10,7 +10,9 @@ that computes it. The order of the table is the order metrics are listed in
 Two scopes:
 
 - "run": one run's records against its truth (`run_metrics`). They are
-  computed in stages: "nav" for every run with records, "alignment" when the
+  computed in stages: "position" (position and velocity errors) for a run
+  that navigates (an alignment holds the site: the ship's own surge and sway
+  are no INS error), "nav" for every run with records, "alignment" when the
   firmware aligns (the theoretical limit of an alignment, seed 001 eq. 21),
   "static_fine" when a fine alignment runs on a static base (seed 001: the
   filter's errors beside the limits).
@@ -35,7 +37,7 @@ from typing import Callable
 import numpy as np
 
 from pyins import analysis, sim
-from pyins.reference import attitude, earth
+from pyins.reference import abi, attitude, earth
 from pyins.reference.fine_align import EPS, EPS_NU
 from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, NMI_TO_M, TWO_PI, UNITS)
 
@@ -111,6 +113,16 @@ class _Run:
         self.err = nav_errors(res)
         self.att = self.err.att_n_rad
         self.level = np.abs(self.att[:, :2]).max(axis=1)
+        nav = np.asarray(res.outputs["mode"]) == abi.PYINS_MODE_NAVIGATE
+        #: the firmware navigated (during an alignment it holds the site and zero velocity:
+        #: a position or velocity error then is the ship's own motion, not the INS's)
+        self.navigates = int(np.count_nonzero(nav)) > 1
+        aligns = bool(spec.config.get("coarse_ticks", 0) or spec.config.get("fine_ticks", 0))
+        #: the records the attitude maxima are judged on: from the end of the alignment (the
+        #: unaligned start is not the INS's error); an alignment-only run: its last record
+        self.judged = (nav if nav.any() else np.arange(len(nav)) == len(nav) - 1) if aligns else \
+            np.ones(len(nav), bool)
+        self.nav = nav if nav.any() else np.ones(len(nav), bool)
 
     @cached_property
     def final_limits(self):
@@ -184,26 +196,29 @@ def _m(name, dimension, unit, scale, description, compute, stage="nav", figure=T
 _M, _ARCSEC, _ARCMIN = 1.0, ARCSEC_TO_RAD, ARCMIN_TO_RAD
 TABLE = (
     _m("horizontal_error_final", "length", "m", _M,
-       "horizontal position error at the end of the run",
-       lambda r: float(r.err.horizontal_m[-1])),
+       "horizontal position error at the end of the run (a run that navigates: an alignment holds "
+       "the site)",
+       lambda r: float(r.err.horizontal_m[-1]), stage="position"),
     _m("horizontal_error_max", "length", "m", _M,
-       "largest horizontal position error over the run",
-       lambda r: float(r.err.horizontal_m.max())),
+       "largest horizontal position error while navigating (after the alignment, if any)",
+       lambda r: float(r.err.horizontal_m[r.nav].max()), stage="position"),
     _m("level_error_final", "angle", "arcsec", _ARCSEC,
        "larger of |phi_E|, |phi_N| at the end of the run",
        lambda r: float(r.level[-1])),
     _m("level_error_max", "angle", "arcsec", _ARCSEC,
-       "largest |phi_E|, |phi_N| over the run",
-       lambda r: float(r.level.max())),
+       "largest |phi_E|, |phi_N| from the end of the alignment (the whole run when the attitude is "
+       "given; an alignment-only run: at its end)",
+       lambda r: float(r.level[r.judged].max())),
     _m("heading_error_final", "angle", "arcmin", _ARCMIN,
        "|phi_U| at the end of the run",
        lambda r: float(abs(r.att[-1, 2]))),
     _m("heading_error_max", "angle", "arcmin", _ARCMIN,
-       "largest |phi_U| over the run",
-       lambda r: float(np.abs(r.att[:, 2]).max())),
+       "largest |phi_U| from the end of the alignment (the whole run when the attitude is given; an "
+       "alignment-only run: at its end)",
+       lambda r: float(np.abs(r.att[r.judged, 2]).max())),
     _m("velocity_error_max", "velocity", "m/s", 1.0,
-       "largest horizontal velocity error component over the run",
-       lambda r: float(np.abs(r.err.vel_n_mps[:, :2]).max())),
+       "largest horizontal velocity error component while navigating (after the alignment, if any)",
+       lambda r: float(np.abs(r.err.vel_n_mps[r.nav, :2]).max()), stage="position"),
     _m("level_error_std", "angle", "arcsec", _ARCSEC,
        "std of the final pitch and roll errors over the runs of a campaign (seeds, headings)",
        lambda vs: float(_std(vs)[:2].max()), stage="group"),
@@ -241,7 +256,7 @@ NAMES = tuple(_BY_NAME)                                            #: every metr
 FIGURE_METRICS = tuple(m.name for m in TABLE if m.figure)           #: what [paper] figures name
 RUN_METRICS = tuple(m.name for m in TABLE if m.scope == "run")
 GROUP_METRICS = tuple(m.name for m in TABLE if m.scope == "group")
-_STAGES = ("nav", "alignment", "static_fine")
+_STAGES = ("position", "nav", "alignment", "static_fine")
 
 
 # ---------------------------------------------------------------------------
@@ -262,8 +277,8 @@ def run_metrics(spec, res):
     if len(res.outputs) == 0:
         return {}
     run = _Run(spec, res)                                            # 1.
-    return {m.name: m.compute(run) for stage in _stages(spec)        # 2-4.
-            for m in TABLE if m.stage == stage}
+    stages = [*(["position"] if run.navigates else []), *_stages(spec)]
+    return {m.name: m.compute(run) for m in TABLE if m.stage in stages}   # 2-4., in the table's order
 
 
 def group_metrics(variants):

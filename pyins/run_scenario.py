@@ -164,8 +164,9 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
             try:
                 if log is not None and interrupted is None:
                     log(f"  {spec.label}: {entry['ticks_done'] * spec.dt / 3600:.3g} h, "
-                        f"max horizontal error {mm.get('horizontal_error_max', float('nan')):.1f} m, "
-                        f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
+                        + (f"max horizontal error {mm['horizontal_error_max']:.1f} m, "
+                           if "horizontal_error_max" in mm else "alignment only, ")
+                        + f"heading error {mm.get('heading_error_final', float('nan')) / ARCMIN_TO_RAD:.3g}' "
                         f"({entry['wall_s']:.1f} s)")
                 with hold_interrupts(defer=True):
                     write_summary(run_dir, summary)

@@ -65,8 +65,10 @@ def _summary_lines(summary):
         if not m:
             out.append(f"  {v['label']}: no records")
             continue
-        out.append(f"  {v['label']}: max horizontal {m['horizontal_error_max']:.1f} m "
-                   f"({m['horizontal_error_max'] / NMI_TO_M:.3f} nmi), "
+        where = (f"max horizontal {m['horizontal_error_max']:.1f} m "
+                 f"({m['horizontal_error_max'] / NMI_TO_M:.3f} nmi), " if "horizontal_error_max" in m
+                 else "alignment only (the site is held: no position error), ")
+        out.append(f"  {v['label']}: {where}"
                    f"final level {m['level_error_final'] / ARCSEC_TO_RAD:.2f}\", "
                    f"final heading {m['heading_error_final'] / ARCMIN_TO_RAD:.3f}'"
                    + ("" if v["complete"] else f"  [partial: {v['ticks_done']} of {v['ticks']} ticks]"))

@@ -219,14 +219,19 @@ def plot_errors(summary, series, path):
             line(ax[1, 1], t, s["east_m"] / pos_scale, **kw)
             line(ax[2, 0], t, dlat / ang_scale, **kw)
             line(ax[2, 1], t, dlon / ang_scale, **kw)
-        line(ax[-1, 0], t, np.abs(s["att_err_n_rad"][:, :2]).max(axis=1) / ARCSEC_TO_RAD, **kw)
-        line(ax[-1, 1], t, s["att_err_n_rad"][:, 2] / ARCMIN_TO_RAD, **kw)
+        # a variant that navigates: its attitude from the end of the alignment (the unaligned start,
+        # degrees, would squash the navigation's arc-seconds flat; alignment.png shows it)
+        k = s["outputs"]["mode"] == abi.PYINS_MODE_NAVIGATE if nav and navigates(s) else slice(None)
+        line(ax[-1, 0], t[k], np.abs(s["att_err_n_rad"][k, :2]).max(axis=1) / ARCSEC_TO_RAD, **kw)
+        line(ax[-1, 1], t[k], s["att_err_n_rad"][k, 2] / ARCMIN_TO_RAD, **kw)
     for a in ax[-1]:
         a.set_xlabel(tl)
     names = ([f"horizontal position error [{pos_unit}]", "horizontal velocity error [m/s]",
               f"north position error [{pos_unit}]", f"east position error [{pos_unit}]",
               f"latitude error [{ang_unit}]", f"longitude error [{ang_unit}]"] if nav else [])
-    names += ["max |level error| [arcsec]", "heading error phi_U [arcmin]"]
+    names += (["max |level error| [arcsec], from the end of the alignment",
+               "heading error phi_U [arcmin], from the end of the alignment"] if nav else
+              ["max |level error| [arcsec]", "heading error phi_U [arcmin]"])
     for a, yl in zip(ax.flat, names):
         a.set_ylabel(yl, fontsize=9)
         a.grid(alpha=0.3)
@@ -349,14 +354,24 @@ def plot_comparison(summary, path):
     fig, ax = plt.subplots(figsize=(10, 4.5))
     ax.bar(x - 0.25, [v["metrics"]["horizontal_error_final"] / sc for v in vs], 0.25, label="ours, final")
     ax.bar(x, [v["metrics"]["horizontal_error_max"] / sc for v in vs], 0.25, label="ours, max")
-    paper = {}
+    paper, bounds = {}, {}
     for f in (summary.get("paper") or {}).get("figures", []):
         if f["metric"].startswith("horizontal_error") and f.get("variant"):
-            paper[f["variant"]] = f["value_si"] / sc
+            # a bound ("<", ">") is drawn as a bound (a line across the variant), a value as a bar
+            (paper if f.get("relation") in (None, "", "=", "~") else bounds)[f["variant"]] = (
+                f["value_si"] / sc, f.get("relation"))
+    caveat = " (for the full-length run: not comparable)" if not_judged(
+        [v for v in vs if v["label"] in paper or v["label"] in bounds]) else ""
     if paper:
-        caveat = not_judged([v for v in vs if v["label"] in paper])
-        ax.bar(x + 0.25, [paper.get(v["label"], 0.0) for v in vs], 0.25,
-               label="paper" + (" (for the full-length run: not comparable)" if caveat else ""))
+        ax.bar(x + 0.25, [paper.get(v["label"], (0.0,))[0] for v in vs], 0.25, label="paper" + caveat)
+    first = True
+    for i, v in enumerate(vs):
+        if v["label"] in bounds:
+            b, rel = bounds[v["label"]]
+            ax.plot([i - 0.4, i + 0.4], [b, b], "k--", lw=1.2,
+                    label=f"paper's bound ({rel} the line){caveat}" if first else None)
+            ax.plot([i + 0.25], [b], "kv" if rel == "<" else "k^", ms=7)
+            first = False
     ax.set_xticks(x, [v["label"] for v in vs], fontsize=8, rotation=10)
     ax.set_ylabel(f"horizontal position error [{un}]")
     ax.grid(alpha=0.3, axis="y")

@@ -243,3 +243,47 @@ def test_run_variant_runs_one_variant_with_its_label(tmp_path, capsys):
     assert _labels(d) == ["traditional two-position"]
     rc, _, err = _run(capsys, "seed002_exp1", "--variant", "4", "--out", str(tmp_path / "x"))
     assert rc == 2 and "--variant 4" in err and "0..3" in err, err
+
+
+def test_attitude_maxima_are_judged_from_the_end_of_the_alignment(tmp_path, capsys):
+    # item 10: level_error_max 4.668e4" and heading_error_max 7941' were the unaligned start.
+    # moored_general aligns for 300 s; 0.1 h leaves 60 s of navigation after it
+    d = tmp_path / "run"
+    rc, _, err = _run(capsys, "moored_general", "--hours", "0.1", "--out", str(d), "--quiet")
+    assert rc == 0, err
+    arcsec, arcmin = 4.84813681109536e-06, 2.908882086657216e-04
+    for v in json.loads((d / "summary.json").read_text())["variants"]:
+        m = v["metrics"]
+        # after the alignment the level error is tens of arc-seconds (final 30-40" here) and 60 s
+        # of navigation adds little (a Schuler period is 84 min): 300" is far below the start's 4.7e4"
+        assert m["level_error_max"] < 300 * arcsec, (v["label"], m["level_error_max"] / arcsec)
+        # TRIAD's heading ends near 81'; the start was 7941'
+        assert m["heading_error_max"] < 200 * arcmin, (v["label"], m["heading_error_max"] / arcmin)
+    from pyins import metrics
+    assert "end of the alignment" in metrics.describe("level_error_max")
+    assert "end of the alignment" in (d / "report.html").read_text()
+
+
+def test_an_alignment_only_run_reports_no_horizontal_error(tmp_path, capsys):
+    # item 11: the ship's own surge and sway (0.4 m) were reported as the horizontal error
+    d = tmp_path / "run"
+    rc, out, err = _run(capsys, "moored_general", "--out", str(d))
+    assert rc == 0, err
+    assert "max horizontal" not in out and "alignment only" in out
+    for v in json.loads((d / "summary.json").read_text())["variants"]:
+        assert not any(k.startswith(("horizontal_error", "velocity_error")) for k in v["metrics"])
+    assert not (d / "comparison.png").exists()
+
+
+def test_comparison_draws_a_paper_bound_as_a_bound(finished, tmp_path, capsys, monkeypatch):
+    # workflow: seed003's "< 1.1 nmi" was drawn as a 1.1 nmi bar beside ours
+    import matplotlib.axes
+    bars = []
+    real = matplotlib.axes.Axes.bar
+    monkeypatch.setattr(matplotlib.axes.Axes, "bar",
+                        lambda self, *a, **k: bars.append(k.get("label")) or real(self, *a, **k))
+    d = tmp_path / "run"
+    shutil.copytree(finished, d)
+    rc, _, err = _report(capsys, d)
+    assert rc == 0, err
+    assert bars and not any(str(b).startswith("paper") for b in bars), bars
