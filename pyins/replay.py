@@ -227,6 +227,18 @@ class _Summary:
         return summary
 
 
+def _json_safe(obj):
+    """``obj`` with every NaN or infinity as None (null): summary.json is JSON
+    (a NaN end state is said in the warnings, not written as NaN)."""
+    if isinstance(obj, dict):
+        return {k: _json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_safe(v) for v in obj]
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def _blocks(data, block):
     """``data`` in blocks: an ImuData split (`pyins.logs.split_blocks`), or
     the blocks of an iterable (a `pyins.logs.LogReader`) as they come."""
@@ -346,8 +358,8 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
                 err.close()
             else:
                 err.abort()
-            records.write_atomic(os.path.join(out_dir, "summary.json"), json.dumps(summary, indent=2),
-                                 sync=False)
+            records.write_atomic(os.path.join(out_dir, "summary.json"),
+                                 json.dumps(_json_safe(summary), indent=2, allow_nan=False), sync=False)
     except BaseException:
         nav.abort()
         err.abort()

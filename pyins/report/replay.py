@@ -193,6 +193,11 @@ def render(out_dir):
     """Figures and report.html of a replay directory; returns the page's path."""
     with open(os.path.join(out_dir, "summary.json")) as f:
         summary = json.load(f)
+    for part in ("aligned", "final", "errors", "fine_alignment"):     # a null figure (NaN) prints as nan
+        if isinstance(summary.get(part), dict):
+            summary[part] = {k: (float("nan") if v is None and k != "time_s" else
+                                 [float("nan") if x is None else x for x in v] if isinstance(v, list) else v)
+                             for k, v in summary[part].items()}
     rec, fine = _records(os.path.join(out_dir, "navigation.npz"))
     hz = summary.get("rate_hz", 100)
     figures = []
