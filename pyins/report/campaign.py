@@ -275,7 +275,9 @@ def plots(camp, out_dir, result, rows):
                 off = (k - (nv - 1) / 2) * width
                 d = {a["group"]: a["value"] for a in gm if a["metric"] == si_name(m) and a["variant"] == v}
                 gx = [gi for gi in range(len(labels)) if d.get(gi) is not None]
-                ax[j].bar(x[gx] + off, [d[gi] / scale for gi in gx], width, label=v)
+                bars = ax[j].bar(x[gx] + off, [d[gi] / scale for gi in gx], width,
+                                 label=v or "std (ddof=1) over the group's runs")
+                ax[j].bar_label(bars, labels=[f"{d[gi] / scale:.3g}" for gi in gx], fontsize=7)
             for f in (result.get("paper") or {}).get("figures", []):
                 if f["metric"] == m:
                     ax[j].axhline(f["value_si"] / scale, color="k", ls="--", lw=1,

@@ -170,3 +170,33 @@ def test_budget_of_an_aligning_scenario_names_the_scenario_keys(capsys):
     rc, out, err = _run(capsys, "budget", "seed000_static", "--hours", "1")
     assert rc == 2 and "run_budget" not in err
     assert "firmware.coarse_time" in err and "firmware.fine_time" in err
+
+
+def test_group_std_bars_are_labelled(tmp_path, capsys, monkeypatch):
+    """Before: plots/group_std.png's bars had no label and no value (the
+    legend showed only the paper's line)."""
+    import matplotlib.figure
+    texts = {}
+    save = matplotlib.figure.Figure.savefig
+
+    def keep(fig, path, *a, **k):
+        texts[str(path)] = ([t.get_text() for ax in fig.axes for t in ax.texts],
+                            [h for ax in fig.axes for h in ax.get_legend_handles_labels()[1]])
+        return save(fig, path, *a, **k)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", keep)
+    rc, out, err = _run(capsys, "campaign", "--scenario", "seed000_static", "--grid", "duration=0.05 h",
+                        "--seeds", "2", "--workers", "1", "--out", tmp_path / "c")
+    assert rc == 0, err
+    values, legend = next(v for p, v in texts.items() if p.endswith("group_std.png"))
+    assert values and all(v for v in values)
+    assert any("std" in h for h in legend)
+
+
+def test_seed002_experiments_say_they_run_four_variants():
+    """Before: their title and description named three schemes; they run four."""
+    from pyins import scenario
+    for name in ("seed002_exp1", "seed002_exp2"):
+        scn = scenario.load(name)
+        assert len(list(scn.runs())) == 4
+        assert "four variants" in " ".join(scn.data["description"].split())
+        assert "literal and derived" in scn.title
