@@ -1,7 +1,11 @@
 """`pyins replay`: a recorded IMU log through the firmware, its errors
 against a reference, its page."""
 import os
+import re
+import shutil
+import stat
 import sys
+import tempfile
 import zipfile
 
 import numpy as np
@@ -90,7 +94,6 @@ _CLI_WORDS = (("pass fmt= one of", "give --format, one of"), ("fmt='binary'", "-
 
 
 def _cli_words(msg):
-    import re
     msg = re.sub(r"columns=\{'(\w+)': (?:NAME|\.\.\.)\}", r"--columns \1=NAME", msg)
     for python, cli in _CLI_WORDS:
         msg = msg.replace(python, cli)
@@ -139,9 +142,6 @@ def _spool(log, fmt):
     a temporary file, whose path is returned with the format (told by the
     name the user gave; a pipe with no extension needs --format). A plain
     file is returned as it is (None: nothing to remove)."""
-    import shutil
-    import stat
-    import tempfile
     if log != "-":
         try:
             mode = os.stat(log).st_mode
