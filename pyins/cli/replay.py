@@ -89,6 +89,8 @@ _CLI_WORDS = (("pass fmt= one of", "give --format, one of"), ("fmt='binary'", "-
               ("differs from dt=", "differs from --dt "), ("table_angle given", "--table-angle given"),
               ("table_angle does not apply", "--table-angle does not apply"),
               ("or pass the names", "or name them with --columns"),
+              ("columns= names CSV header columns or npz arrays; it does not apply to ",
+               "--columns names CSV header columns or npz arrays; it does not apply to --format "),
               ("unit, axis, scale and column options", "--kind, --gyro-unit, --accel-unit, --axes, "
                                                       "--gyro-scale, --accel-scale and --columns"))
 

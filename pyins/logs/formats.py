@@ -14,7 +14,7 @@ import numpy as np
 from pyins.logs.files import _full, _lines, _opener, _read_bytes, _read_exact
 from pyins.logs.issues import LogError, _plural
 from pyins.logs.options import CSV_ALIASES, CSV_ROLES, NPZ_ALIASES, _columns
-from pyins.logs.project import CSV_HEADER, _NPZ_KEYS
+from pyins.logs.project import _npz_why, CSV_HEADER, _NPZ_KEYS
 from pyins.units import ARCSEC_TO_RAD
 
 
@@ -355,7 +355,7 @@ def _parse_npz(path, name, opt):
         npz = np.load(_io.BytesIO(raw), allow_pickle=False)
         files = list(npz.files)
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise LogError(f"{name}: not a readable .npz file ({exc or 'empty'}): cut, damaged or not an npz") from None
+        raise LogError(f"{name}: not a readable .npz file ({_npz_why(exc)}): cut, damaged or not an npz") from None
     if opt.columns is None and all(k in files for k in _NPZ_KEYS):
         return None
     lower = {f.lower(): f for f in files}

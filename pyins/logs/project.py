@@ -89,6 +89,17 @@ def save_npz(path, dtheta_p, dv_p, table_angle_rad, dt, metadata=None, tick=None
                  metadata=np.array(meta))
 
 
+def _npz_why(exc):
+    """What numpy said of a file that is not an npz, in a few words (a text file
+    reads to numpy as pickled data: it is not a zip archive)."""
+    text = str(exc)
+    if not text or "No data left" in text:
+        return "empty"
+    if "pickle" in text:
+        return "not a zip archive"
+    return text
+
+
 def load_npz(path, file=None):
     """Read a file written by `save_npz`; returns `ImuData`. ``file``: a binary
     file object to read instead of opening ``path`` (pyins.logs' reader hands in
@@ -97,7 +108,7 @@ def load_npz(path, file=None):
     try:
         npz = np.load(path if file is None else file, allow_pickle=False)
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise ValueError(f"{name}: not a readable .npz file ({exc or 'empty'}): cut, damaged or not an npz") from exc
+        raise ValueError(f"{name}: not a readable .npz file ({_npz_why(exc)}): cut, damaged or not an npz") from exc
     with npz:
         missing = [k for k in _NPZ_KEYS if k not in npz.files]
         if missing:

@@ -331,3 +331,13 @@ def test_a_log_without_gravity_names_options_only(tmp_path, log100, capsys):
                              "--lat", str(LAT), "--lon", str(LON), "--height", "0", "--coarse", "40", "--out",
                              str(tmp_path / "o"), "--quiet"], "--accel-unit", "--kind")
     assert "plausibility" not in line and "accel_unit" not in line
+
+
+def test_a_text_log_read_as_npz_and_columns_on_text_name_options(tmp_path, log100, capsys):
+    """Before: numpy's 'pickled (object) data ... allow_pickle=' for a text file
+    given --format npz, and 'columns= names CSV header columns' for --columns."""
+    base = ["replay", str(log100), *SITE_ARGS, "--coarse", "40", "--out", str(tmp_path / "o"), "--quiet"]
+    line = _refused(capsys, base + ["--format", "npz"], "log100.txt", "not a zip archive")
+    assert "pickle" not in line
+    line = _refused(capsys, base + ["--columns", "t=time"], "--columns", "--format text")
+    assert "columns=" not in line
