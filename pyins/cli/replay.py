@@ -194,11 +194,10 @@ def cmd_replay(args):
 
 
 def _replay(args, path, fmt):
-    if args.time_col == "none" and args.dt is None and args.rate is not None:
-        args.dt = 1.0 / args.rate      # --rate states the interval of a log without time (its --help)
-
-
-    read_kw = dict(dt=args.dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
+    dt = args.dt
+    if args.time_col == "none" and dt is None and args.rate is not None:
+        dt = 1.0 / args.rate      # --rate states the interval of a log without time (its --help)
+    read_kw = dict(dt=dt, kind=args.kind, gyro_unit=args.gyro_unit, accel_unit=args.accel_unit,
                    axes=args.axes, time_col=args.time_col, gyro_scale=args.gyro_scale,
                    accel_scale=args.accel_scale)
     if args.table_angle is not None:
