@@ -256,7 +256,7 @@ def _own(name):
     return name in OWN_FILES or any(name.startswith(f + ".") for f in OWN_FILES)
 
 
-def claim_dir(out_dir):
+def claim_dir(out_dir, keep=None):
     """Make ``out_dir`` the new replay's: an earlier replay's files there
     (`OWN_FILES`, and the temporary files a killed one left) are removed, so
     that nothing of it (an errors.npz the new replay has no reference for)
@@ -274,6 +274,11 @@ def claim_dir(out_dir):
         shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
         raise ValueError(f"--out {out_dir}: holds files that are not a replay's ({shown}): give an "
                          "empty or new directory, or one an earlier replay wrote (it is replaced)")
+    for n in names:
+        path = os.path.join(out_dir, n)
+        if keep is not None and os.path.exists(keep) and os.path.samefile(path, keep):
+            raise ValueError(f"--out {out_dir}: holds the log being replayed ({n}), which a replay there "
+                             "would replace: give another --out")
     for n in names:
         os.remove(os.path.join(out_dir, n))
     return False
@@ -314,7 +319,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
 
     # 1. the log through the firmware, block by block, the records written as they come
     fw = engines.firmware(engine, cfg)
-    made = claim_dir(out_dir)
+    made = claim_dir(out_dir, keep=log_path if log_path and log_path != "-" else None)
     nav = logs.NpzWriter(os.path.join(out_dir, "navigation.npz"))
     err = logs.NpzWriter(os.path.join(out_dir, "errors.npz"))
     acc = _Summary(cfg, hz, spec, reference, err, t_first=t_first)

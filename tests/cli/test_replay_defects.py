@@ -118,6 +118,13 @@ def test_a_replay_replaces_an_earlier_replay_in_its_directory(tmp_path, log100, 
     (out / "notes.txt").write_text("mine")
     _refused(capsys, base, "--out", "notes.txt", "not a replay's")
     assert (out / "notes.txt").read_text() == "mine"
+    # nor is the log being replayed, whatever its name
+    (out / "notes.txt").unlink()
+    log = out / "errors.npz"
+    logs.write_log(str(log), logs.read_log(str(log100), time_col="first", axes="frd"))
+    _refused(capsys, ["replay", str(log), "--lat", str(LAT), "--lon", str(LON), "--height", "0", "--coarse", "40",
+                      "--out", str(out), "--quiet"], "holds the log being replayed")
+    assert log.exists()
 
 
 # -- 7. a rates log with a gap -------------------------------------------------------------------------
