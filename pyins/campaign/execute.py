@@ -305,14 +305,20 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
     """
     t0 = time.perf_counter()
     out_dir = str(out_dir)
-    lock = records.lock_dir(out_dir, what="campaign directory", notice=notice)
+    notes = []                  # every notice told is kept in campaign.json (execution.notes)
+
+    def noting(text):
+        notes.append(text)
+        if notice is not None:
+            notice(text)
+    lock = records.lock_dir(out_dir, what="campaign directory", notice=noting)
     try:
-        return _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notice, t0)
+        return _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, noting, t0, notes)
     finally:
         lock.release()
 
 
-def _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notice, t0):
+def _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notice, t0, notes):
     os.makedirs(os.path.join(out_dir, "runs"), exist_ok=True)
     # 1. what is missing
     todo, total = pending(camp, out_dir)
@@ -369,7 +375,7 @@ def _run_campaign(camp, out_dir, workers, scheduler, progress, log, plots, notic
         ended = state["computed"] + len(state["failed"]) + len(state["interrupted"])
         result["execution"] = {"scheduler": how, "runs": total, "computed": state["computed"],
                                "skipped": skipped, "failed": state["failed"],
-                               "wall_s": time.perf_counter() - t0}
+                               "wall_s": time.perf_counter() - t0, "notes": list(notes)}
         if interrupted:
             result["execution"].update(interrupted=True, stopped=state["interrupted"],
                                        not_started=len(tasks) - ended)

@@ -8,7 +8,7 @@ import time
 from pyins import budget, campaign, scenario
 from pyins.units import NMI_TO_M
 
-from .common import (EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
+from .common import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
                      set_overrides)
 
 
@@ -119,6 +119,15 @@ def cmd_campaign(args):
                                        progress=progress,
                                        notice=lambda text: print(f"pyins campaign: note: {text}",
                                                                  file=sys.stderr))
+    except campaign.CampaignError as exc:
+        bar.end()
+        if exc.result is None:          # it could not run (no dask, no scheduler): the input's
+            raise InputError(str(exc)) from None
+        # runs failed: every other result is written; one line naming the first failure
+        print(f"pyins campaign: {exc}", file=sys.stderr)
+        print(f"  aggregates of the others: {os.path.join(out, 'aggregate.md')}", file=sys.stderr)
+        emit_json(args, exc.result)
+        return EXIT_FAILED
     except KeyboardInterrupt as exc:
         bar.end()
         ex = (getattr(exc, "result", None) or {}).get("execution", {})

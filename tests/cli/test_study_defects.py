@@ -200,3 +200,19 @@ def test_seed002_experiments_say_they_run_four_variants():
         assert len(list(scn.runs())) == 4
         assert "four variants" in " ".join(scn.data["description"].split())
         assert "literal and derived" in scn.title
+
+
+def test_a_campaign_whose_runs_fail_says_so_without_internal_error(tmp_path, capsys, monkeypatch):
+    """Before: CampaignError (a RuntimeError) reached main as 'internal
+    error CampaignError: ... (rerun with --debug)'."""
+    from pyins.campaign import execute
+
+    def failing(task):
+        raise ValueError("the firmware stopped")
+    monkeypatch.setattr(execute, "_run_point", failing)
+    rc, out, err = _run(capsys, "campaign", "--scenario", "seed003", "--seeds", "2", "--workers", "1",
+                        "--out", tmp_path / "c")
+    assert rc == 1 and "internal error" not in err
+    assert "2 of 2 runs failed" in err and "the firmware stopped" in err
+    camp = json.loads((tmp_path / "c" / "campaign.json").read_text())
+    assert len(camp["execution"]["failed"]) == 2 and camp["execution"]["notes"] == []
