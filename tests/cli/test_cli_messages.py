@@ -219,3 +219,28 @@ def test_a_bad_value_is_refused_or_taken_with_a_clear_message(cmd, option, value
     words = set(re.findall(r"\b[A-Za-z_][A-Za-z0-9_]*\b", text))
     bad = sorted(words & INTERNAL)
     assert not bad, f"names internal function(s) {bad}: {shown}"
+
+
+@pytest.mark.parametrize("cmd", sorted(_subparsers()))
+def test_every_json_is_valid_json(cmd, workdir, tmp_path, capsys):
+    """--json of every subcommand (a cheap run of it): one JSON object that a
+    strict reader takes (no NaN, no Infinity), or nothing (version)."""
+    import json
+    p = _subparsers()[cmd]
+    spec = dict(_base(cmd, workdir))
+    if "--out" in spec:
+        spec["--out"] = str(tmp_path / "out")
+    if cmd == "simulate":
+        spec["log"] = str(tmp_path / "sim.bin")
+    spec["--json"] = True
+    try:
+        rc = cli.main(_argv(cmd, spec, p))
+    except SystemExit as exc:
+        rc = exc.code
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+
+    def strict(c):
+        raise AssertionError(f"pyins {cmd} --json: {c} is not JSON")
+    if out.strip().startswith("{"):
+        json.loads(out, parse_constant=strict)
