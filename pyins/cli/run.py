@@ -1,6 +1,7 @@
 """`pyins run`, `pyins report` and `pyins demo`: a scenario into a run
 directory, a run directory's page, and the set-up's main job."""
 import json
+import math
 import os
 import shlex
 import sys
@@ -58,6 +59,24 @@ def add_demo(cmd):
                    help="output directory (default runs/setup_demo: `pyins run demo` writes runs/demo)")
 
 
+#: The longest run a scenario takes (its duration's limit, 30 d)
+MAX_HOURS = 720.0
+
+
+def check_hours(hours, option="--hours"):
+    """--hours checked: a finite ship time, > 0 and at most MAX_HOURS (InputError naming the option)."""
+    if hours is not None and not (math.isfinite(hours) and 0 < hours <= MAX_HOURS):
+        raise InputError(f"{option} {hours:g}: must be a ship time in hours, > 0 and at most {MAX_HOURS:g} (30 d)")
+    return hours
+
+
+def check_out(out):
+    """--out checked: a directory or nothing yet (InputError naming it)."""
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise InputError(f"--out {out}: a file, not a directory: give a directory (new or a run's)")
+    return out
+
+
 def _summary_lines(summary):
     out = []
     for v in summary["variants"]:
@@ -96,6 +115,9 @@ def _resume_command(args, out):
 
 
 def cmd_run(args):
+    check_hours(args.hours)
+    if args.out is not None:
+        check_out(args.out)
     scn = scenario.load(args.scenario)
     overrides = set_overrides(args)
     if args.seed is not None:
@@ -104,7 +126,7 @@ def cmd_run(args):
         scn = scn.with_overrides(overrides)
     if args.variant is not None:
         scn = scn.only_variant(args.variant)
-    out = args.out or default_out(scn.name)
+    out = check_out(args.out or default_out(scn.name))
 
     def started():
         say(args, f"pyins run {scn.name}: {scn.title}\n  -> {out}")
@@ -154,6 +176,10 @@ def cmd_report(args):
 
 
 def cmd_demo(args):
+    check_hours(args.hours)
+    if args.seed < 0:
+        raise InputError(f"--seed {args.seed}: must be >= 0")
+    check_out(args.out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -50,6 +50,15 @@ def _load_for_a_log(name, hours):
 
 
 def cmd_simulate(args):
+    from .run import check_hours
+    check_hours(args.hours)
+    if args.format is not None and args.format not in logs.FORMATS:
+        raise InputError(f"--format {args.format}: not one of {', '.join(logs.FORMATS)}")
+    try:
+        logs.format_of(args.log, args.format)
+    except ValueError:
+        raise InputError(f"{args.log}: cannot tell the format from the extension: give --format "
+                         f"({', '.join(logs.FORMATS)}) or a known extension ({', '.join(logs.EXTENSIONS)})") from None
     scn, notes = _load_for_a_log(args.scenario, args.hours)
     for note in notes:
         print(f"pyins simulate: note: {note}", file=sys.stderr)

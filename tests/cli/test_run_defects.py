@@ -287,3 +287,26 @@ def test_comparison_draws_a_paper_bound_as_a_bound(finished, tmp_path, capsys, m
     rc, _, err = _report(capsys, d)
     assert rc == 0, err
     assert bars and not any(str(b).startswith("paper") for b in bars), bars
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["run", "seed003", "--hours", "0"], "--hours 0"),
+    (["run", "seed003", "--hours", "nan"], "--hours nan"),
+    (["run", "seed003", "--hours", "1e9"], "--hours 1e+09"),
+    (["simulate", "seed003", "LOG.bin", "--hours", "inf"], "--hours inf"),
+    (["simulate", "seed003", "LOG.bin", "--format", "bogus"], "--format bogus"),
+    (["demo", "--hours", "1e12"], "--hours 1e+12"),
+    (["demo", "--seed", "-1"], "--seed -1"),
+    (["run", "seed003", "--out", "AFILE"], "--out"),
+    (["demo", "--out", "AFILE"], "--out"),
+])
+def test_a_bad_option_value_is_one_line_naming_the_option(tmp_path, capsys, argv, says):
+    # item 23: "fmt 'bogus'" (a Python argument), "expected non-negative integer", a demo of 1e12 h
+    # that ran, "File exists" for an --out that is a file
+    (tmp_path / "afile").write_text("mine")
+    argv = [str(tmp_path / "afile") if a == "AFILE" else str(tmp_path / "x.bin") if a == "LOG.bin" else a
+            for a in argv]
+    rc = cli.main(argv)
+    err = capsys.readouterr().err
+    assert rc == 2 and says in err and len(err.strip().splitlines()) == 1, err
+    assert (tmp_path / "afile").read_text() == "mine"
