@@ -10,6 +10,7 @@ from pyins.units import NMI_TO_M
 
 from .common import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
                      set_overrides)
+from .run import check_hours
 
 
 #: The examples each subcommand's --help ends with.
@@ -150,6 +151,7 @@ def cmd_budget(args):
     """Each sensor error's signed share of a scenario's errors: the linear model of
     pyins.budget.run_budget on one closed-loop run per variant; --check runs every
     source alone through the firmware too (docs/concepts.md, "The error budget")."""
+    check_hours(args.hours)                     # as pyins run: one line naming --hours
     scn = scenario.load(args.scenario)
     overrides = set_overrides(args)
     if overrides:

@@ -98,10 +98,8 @@ def _cases():
 #: (command, option, value) -> the defect it shows (in another engineer's
 #: area: reported, not fixed here). strict: fixed and still marked fails.
 XFAIL = {
-    ("simulate", "log", "empty"): "simulate to a path with no extension (here a directory) says 'pass fmt= one "
-                                  "of (...)': a Python argument, not --format (pyins/logs, pyins/cli/simulate.py)",
-    ("demo", "--hours", "large"): "demo --hours 1e12 starts a run of 1e12 h instead of refusing a duration no "
-                                  "one can wait for (the check in pyins/__main__.py takes any positive number)",
+    # were: ("simulate", "log", "empty") 'pass fmt= one of (...)' and ("demo", "--hours", "large") a run of
+    # 1e12 h started; both fixed by b2adb0b (issue 28 item 23) while this test was written
 }
 
 FORBIDDEN = [re.compile(r"\b(fmt|time_col|dt|every|engine|scheme)="), re.compile(r"\bpass dt\b"),

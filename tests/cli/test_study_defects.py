@@ -216,3 +216,11 @@ def test_a_campaign_whose_runs_fail_says_so_without_internal_error(tmp_path, cap
     assert "2 of 2 runs failed" in err and "the firmware stopped" in err
     camp = json.loads((tmp_path / "c" / "campaign.json").read_text())
     assert len(camp["execution"]["failed"]) == 2 and camp["execution"]["notes"] == []
+
+
+@pytest.mark.parametrize("hours", ["nan", "0", "-1", "1e12"])
+def test_budget_hours_out_of_range_names_the_option(capsys, hours):
+    """Before: 'seed003.toml (with overrides): duration: 'nan h' does not start
+    with a number' (the scenario's key for a value given as --hours)."""
+    rc, out, err = _run(capsys, "budget", "seed003", "--hours", hours)
+    assert rc == 2 and err.startswith(f"pyins budget: --hours ") and "duration:" not in err
