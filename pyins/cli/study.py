@@ -6,6 +6,7 @@ import sys
 import time
 
 from pyins import budget, campaign, scenario
+from pyins.metrics import display
 from pyins.units import NMI_TO_M
 
 from .common import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
@@ -65,7 +66,6 @@ def _campaign_option_error(exc, args):
 def _headline(result):
     """The headline lines of a campaign's aggregate: per group (and variant),
     the mean, std and max of its main metrics, in the report's units."""
-    from pyins.metrics import display
     main = ("horizontal_error_final", "horizontal_error_max", "heading_error_final")
     lines = []
     groups = {g["index"]: g["label"] for g in result.get("groups", [])}
