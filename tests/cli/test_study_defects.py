@@ -224,3 +224,18 @@ def test_budget_hours_out_of_range_names_the_option(capsys, hours):
     with a number' (the scenario's key for a value given as --hours)."""
     rc, out, err = _run(capsys, "budget", "seed003", "--hours", hours)
     assert rc == 2 and err.startswith(f"pyins budget: --hours ") and "duration:" not in err
+
+
+def test_progress_hook_for_long_steps(capsys):
+    """common.progress_hook(args, label): the label on stderr and a
+    progress(done, total) callable (a bar with the time left on a terminal);
+    None with --quiet or --json (for pyins simulate's long writes)."""
+    from argparse import Namespace
+
+    from pyins.cli.common import progress_hook
+    assert progress_hook(Namespace(quiet=True, json=False), "x") is None
+    assert progress_hook(Namespace(quiet=False, json=True), "x") is None
+    bar = progress_hook(Namespace(quiet=False, json=False), "writing x.bin")
+    bar(10, 100)
+    bar(100, 100)
+    assert "writing x.bin" in capsys.readouterr().err
