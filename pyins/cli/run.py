@@ -236,7 +236,7 @@ def cmd_demo(args):
     fig.suptitle(f"pyins demo: {summary['scenario']}, sensors {args.sensors}")
     fig.tight_layout()
     plot = os.path.join(args.out, "navigation_errors.png")
-    fig.savefig(plot, dpi=100)
+    records.write_atomic(plot, write=lambda f: fig.savefig(f, format="png", dpi=100), sync=False)
     records.write_atomic(os.path.join(args.out, "summary.json"), json.dumps(summary, indent=2))
     print(f"pyins demo: {args.hours:g} h of ship time through the C++ firmware in {wall:.1f} s wall")
     print(f"  max horizontal position error {summary['max_horizontal_error_m']:.1f} m "
