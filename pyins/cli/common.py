@@ -76,6 +76,17 @@ def emit_json(args, obj):
         print(json.dumps(clean, indent=2, allow_nan=False, default=str))
 
 
+#: The longest run a scenario takes (its duration's limit, 30 d)
+MAX_HOURS = 720.0
+
+
+def check_hours(hours, option="--hours"):
+    """--hours checked: a finite ship time, > 0 and at most MAX_HOURS (InputError naming the option)."""
+    if hours is not None and not (math.isfinite(hours) and 0 < hours <= MAX_HOURS):
+        raise InputError(f"{option} {hours:g}: must be a ship time in hours, > 0 and at most {MAX_HOURS:g} (30 d)")
+    return hours
+
+
 def progress_hook(args, label):
     """A progress callable ``progress(done, total)`` (ticks) for a long step
     of a subcommand (``pyins simulate``, a budget's runs): prints ``label``,

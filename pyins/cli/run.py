@@ -1,7 +1,6 @@
 """`pyins run`, `pyins report` and `pyins demo`: a scenario into a run
 directory, a run directory's page, and the set-up's main job."""
 import json
-import math
 import os
 import shlex
 import sys
@@ -14,7 +13,7 @@ from pyins.progress import phase
 from pyins.report.paper import paper_rows
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
 
-from .common import (EXIT_INTERRUPTED, EXIT_OK, InputError, TICKS_PER_HOUR, default_out, emit_json,
+from .common import (EXIT_INTERRUPTED, EXIT_OK, InputError, TICKS_PER_HOUR, check_hours, default_out, emit_json,
                      phases, progress_bars, say, set_overrides)
 
 
@@ -57,17 +56,6 @@ def add_demo(cmd):
     p.add_argument("--seed", type=int, default=1, help="noise seed")
     p.add_argument("--out", default=os.path.join("runs", "setup_demo"),
                    help="output directory (default runs/setup_demo: `pyins run demo` writes runs/demo)")
-
-
-#: The longest run a scenario takes (its duration's limit, 30 d)
-MAX_HOURS = 720.0
-
-
-def check_hours(hours, option="--hours"):
-    """--hours checked: a finite ship time, > 0 and at most MAX_HOURS (InputError naming the option)."""
-    if hours is not None and not (math.isfinite(hours) and 0 < hours <= MAX_HOURS):
-        raise InputError(f"{option} {hours:g}: must be a ship time in hours, > 0 and at most {MAX_HOURS:g} (30 d)")
-    return hours
 
 
 def check_out(out):

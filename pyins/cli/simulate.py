@@ -5,7 +5,7 @@ import numpy as np
 
 from pyins import logs, scenario, sim
 
-from .common import EXIT_OK, InputError, emit_json, say
+from .common import EXIT_OK, InputError, check_hours, emit_json, progress_hook, say
 
 
 #: The examples each subcommand's --help ends with.
@@ -50,7 +50,6 @@ def _load_for_a_log(name, hours):
 
 
 def cmd_simulate(args):
-    from .run import check_hours
     check_hours(args.hours)
     if args.format is not None and args.format not in logs.FORMATS:
         raise InputError(f"--format {args.format}: not one of {', '.join(logs.FORMATS)}")
@@ -76,6 +75,7 @@ def cmd_simulate(args):
     metadata = dict(scenario=scn.text, notes=notes, scenario_name=scn.name, variant=args.variant, digest=scn.digest())
     # written as the chunks come (bounded memory); the file appears under its name when complete
     n = 0
+    bar = progress_hook(args, f"simulating {spec.duration_ticks * spec.dt / 3600:.3g} h of {scn.name} [{spec.label}]")
     with logs.LogWriter(args.log, fmt, dt=spec.dt, metadata=metadata) as log:
         for chunk in sim.generate(spec.motion, spec.duration_ticks, chunk_ticks=200_000,
                                   dt=spec.dt, table=sim.Fixed(alpha0), sensors=sensors, with_truth=False):
@@ -83,6 +83,8 @@ def cmd_simulate(args):
                                      dv_p=chunk.dv_p, table_angle_rad=chunk.table_angle, dt=spec.dt,
                                      metadata=metadata))
             n += len(chunk.tick)
+            if bar is not None:
+                bar(n, spec.duration_ticks)
     say(args, f"pyins simulate {scn.name} [{spec.label}]: {n} samples "
                f"({n * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
     emit_json(args, dict(log=args.log, format=fmt, samples=n, scenario=scn.name,

@@ -9,9 +9,8 @@ from pyins import budget, campaign, scenario
 from pyins.metrics import display
 from pyins.units import NMI_TO_M
 
-from .common import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, emit_json, say,
-                     set_overrides)
-from .run import check_hours
+from .common import (EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, CountProgress, InputError, TICKS_PER_HOUR, check_hours,
+                     emit_json, say, set_overrides)
 
 
 #: The examples each subcommand's --help ends with.

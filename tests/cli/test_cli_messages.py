@@ -164,7 +164,8 @@ def _params():
 
 
 @pytest.mark.parametrize("cmd, option, value", _params())
-def test_a_bad_value_is_refused_or_taken_with_a_clear_message(cmd, option, value, workdir, tmp_path, capsys):
+def test_a_bad_value_is_refused_or_taken_with_a_clear_message(cmd, option, value, workdir, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)   # a relative --out value ("-1", "nan") is written here, not in the checkout
     global INTERNAL
     if INTERNAL is None:
         INTERNAL = _internal_names()

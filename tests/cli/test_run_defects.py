@@ -310,3 +310,15 @@ def test_a_bad_option_value_is_one_line_naming_the_option(tmp_path, capsys, argv
     err = capsys.readouterr().err
     assert rc == 2 and says in err and len(err.strip().splitlines()) == 1, err
     assert (tmp_path / "afile").read_text() == "mine"
+
+
+def test_simulate_says_what_it_is_doing_while_it_writes(tmp_path, capsys):
+    """A long `pyins simulate` (72 h of seed002_exp1 took 98 s) printed
+    nothing until it ended: it names the step on stderr and draws its bar
+    there as the chunks come; --quiet keeps it silent."""
+    log = tmp_path / "x.npz"
+    assert cli.main(["simulate", "demo", str(log), "--hours", "0.01"]) == 0
+    err = capsys.readouterr().err
+    assert "simulating 0.01 h of demo" in err
+    assert cli.main(["simulate", "demo", str(tmp_path / "y.npz"), "--hours", "0.01", "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
