@@ -6,7 +6,7 @@ closed loop, the compiled plant (`pyins.native.Plant`); ``"reference"`` runs
 the NumPy mirror of the core (`pyins.reference.Firmware`, the same
 constructor, ``step``, ``run``, ``snapshot``/``restore`` and records of
 ``native.OUTPUT_DTYPE``) and the NumPy mirror of the plant (`MirrorPlant`,
-over `pyins.sim.turntable`), about a thousand times slower. Everything above
+over `pyins.sim.turntable`), three orders of magnitude slower (`pyins bench`). Everything above
 (open_loop, fil, run_scenario, the CLI's ``--engine``) is the same code for both.
 
 The reference engine needs no compiled library: `pyins.native` is imported
