@@ -226,11 +226,12 @@ def cmd_demo(args):
     plot = os.path.join(args.out, "navigation_errors.png")
     records.write_atomic(plot, write=lambda f: fig.savefig(f, format="png", dpi=100), sync=False)
     records.write_atomic(os.path.join(args.out, "summary.json"), json.dumps(summary, indent=2))
-    print(f"pyins demo: {args.hours:g} h of ship time through the C++ firmware in {wall:.1f} s wall")
-    print(f"  max horizontal position error {summary['max_horizontal_error_m']:.1f} m "
-          f"({summary['max_horizontal_error_nmi']:.3f} nmi), final {summary['final_horizontal_error_m']:.1f} m")
-    print(f"  max level error {summary['max_level_error_arcsec']:.2f} arcsec, "
-          f"max heading error {summary['max_heading_error_arcmin']:.3f} arcmin, "
-          f"max velocity error {summary['max_velocity_error_mps']:.4f} m/s")
-    print(f"  plot: {plot}  figures: {os.path.join(args.out, 'summary.json')}")
-    return 0
+    say(args, f"pyins demo: {args.hours:g} h of ship time through the C++ firmware in {wall:.1f} s wall")
+    say(args, f"  max horizontal position error {summary['max_horizontal_error_m']:.1f} m "
+              f"({summary['max_horizontal_error_nmi']:.3f} nmi), final {summary['final_horizontal_error_m']:.1f} m")
+    say(args, f"  max level error {summary['max_level_error_arcsec']:.2f} arcsec, "
+              f"max heading error {summary['max_heading_error_arcmin']:.3f} arcmin, "
+              f"max velocity error {summary['max_velocity_error_mps']:.4f} m/s")
+    say(args, f"  plot: {plot}  figures: {os.path.join(args.out, 'summary.json')}")
+    emit_json(args, summary)
+    return EXIT_OK

@@ -322,3 +322,14 @@ def test_simulate_says_what_it_is_doing_while_it_writes(tmp_path, capsys):
     assert "simulating 0.01 h of demo" in err
     assert cli.main(["simulate", "demo", str(tmp_path / "y.npz"), "--hours", "0.01", "--quiet"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_demo_keeps_quiet_and_json_as_every_subcommand(tmp_path, capsys):
+    """`pyins demo --quiet` printed its four lines all the same, and
+    `--json` printed them and no JSON: --quiet prints nothing, --json one
+    JSON object, the summary.json it wrote."""
+    assert cli.main(["demo", "--hours", "0.01", "--out", str(tmp_path / "q"), "--quiet"]) == 0
+    assert capsys.readouterr().out == ""
+    assert cli.main(["demo", "--hours", "0.01", "--out", str(tmp_path / "j"), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed == json.loads((tmp_path / "j" / "summary.json").read_text())
