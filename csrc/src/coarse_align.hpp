@@ -126,7 +126,11 @@ struct Params {
     double gravity;          ///< normal gravity at the site [m/s^2]
     int64_t settle_from;     ///< first tick of the wander test
     int32_t noise_every;     ///< ticks per block of the noise measurement (tau); 0: none
+    int32_t unused = 0;      ///< fills the tail: no padding, so a Params copied from a stack
+                             ///< local (CoarseAlign::prm) carries no undefined bytes into a snapshot
 };
+static_assert(sizeof(Params) == 6 * sizeof(int32_t) + 5 * sizeof(double) + sizeof(int64_t),
+              "coarse_align::Params has no padding");
 
 /// Second differences needed before measured_vrw reports a value (5 s at
 /// 10 blocks per second: the estimate's relative sigma is then ~15 %).

@@ -71,6 +71,7 @@ struct Step {
 struct Params {
     Step steps[kMaxSteps];
     int32_t n_steps;       ///< 0: no rotation (the table stays put)
+    int32_t isolate;       ///< 1: heading isolation (counter-rotate against the ship's yaw)
     double rate;           ///< cruise rate [rad/s] > 0
     double accel;          ///< acceleration [rad/s^2] > 0
     double delta;          ///< flexible threshold (0.01 at 100 Hz, seed 002)
@@ -80,8 +81,12 @@ struct Params {
     int32_t timeout_ticks; ///< how long the encoder may lag
     int32_t sums;          ///< kSumsStops: A_c, A_s over stopped ticks (seed 002); kSumsAll: every tick
     double dt;             ///< tick [s]
-    int32_t isolate;       ///< 1: heading isolation (counter-rotate against the ship's yaw)
 };
+// Every int32 beside another: no padding, so a Params copied from a stack
+// local (Indexer::prm) carries no undefined bytes into a snapshot.
+static_assert(sizeof(Step) == 2 * sizeof(int32_t) + sizeof(double), "indexing::Step has no padding");
+static_assert(sizeof(Params) == kMaxSteps * sizeof(Step) + 7 * sizeof(double) + 4 * sizeof(int32_t),
+              "indexing::Params has no padding");
 
 struct Indexer {
     Params prm;

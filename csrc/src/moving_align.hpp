@@ -83,6 +83,7 @@ struct Params {
     double rn_h;             ///< R_N + h at the site [m]
     double dt;               ///< tick [s]
     int32_t meas_every;      ///< ticks per update
+    int32_t nis_window;      ///< updates per NIS window; 0: no test
     double gyro_arw;         ///< [rad/sqrt(s)]
     double accel_vrw;        ///< [(m/s)/sqrt(s)]
     double pos_sigma;        ///< R: the waves' horizontal displacement [m]
@@ -91,9 +92,11 @@ struct Params {
     double sigma0_vel;       ///< [m/s]
     double sigma0_gyro;      ///< [rad/s]
     double sigma0_accel;     ///< [m/s^2]
-    int32_t nis_window;      ///< updates per NIS window; 0: no test
     double nis_max;
 };
+// The two int32 side by side: no padding, so a Params copied from a stack
+// local (MovingAlign::prm) carries no undefined bytes into a snapshot.
+static_assert(sizeof(Params) == 16 * sizeof(double) + 2 * sizeof(int32_t), "moving_align::Params has no padding");
 
 struct MovingAlign {
     Params prm;
