@@ -54,14 +54,17 @@ struct Params {
     double gravity;          ///< [m/s^2]
     double dt;               ///< tick [s]
     int32_t meas_every;      ///< ticks per measurement
+    int32_t nis_window;      ///< updates per NIS window; 0: no test
     double gyro_arw;         ///< [rad/sqrt(s)]
     double accel_vrw;        ///< [(m/s)/sqrt(s)]
     double sigma0_att[3];    ///< [rad] E, N, U
     double sigma0_gyro;      ///< [rad/s]
     double sigma0_accel;     ///< [m/s^2] (8-state only)
-    int32_t nis_window;      ///< updates per NIS window; 0: no test
     double nis_max;          ///< bound on a window's mean NIS
 };
+// The two int32 side by side: no padding, so a Params copied from a stack
+// local (FineFilter::init) carries no undefined bytes into a snapshot.
+static_assert(sizeof(Params) == 12 * sizeof(double) + 2 * sizeof(int32_t), "fine_align::Params has no padding");
 
 /// State indices, the layouts above (the mirror's PHI, EPS, NABLA, EPS_NU),
 /// in the order the output record's kf_x and kf_sigma hold them.
