@@ -9,7 +9,7 @@
   which writes a dict of fields into a ``pyins_config`` struct with the
   checks of name, shape and type both engines apply;
 - the status texts of ``pyins_status_str`` (`status_str`) and the errors
-  `CoreError`, `ConfigError`, `SampleError`, `SnapshotError`, `PlantError`;
+  `CoreError`, `ConfigError`, `SampleError`, `RefError`, `SnapshotError`, `PlantError`;
 - `make_samples` and the array checks of the engines' inputs.
 
 The header is ``pyins_core.h`` installed inside the package (``pip install
@@ -90,6 +90,8 @@ SAMPLE_DTYPE = struct_dtype("pyins_sample")
 OUTPUT_DTYPE = struct_dtype("pyins_output")
 #: The compact record (pyins_nav): OUTPUT_DTYPE's fields of the same names.
 NAV_DTYPE = struct_dtype("pyins_nav")
+#: An external reference measurement (pyins_ref), what ``push_ref`` takes.
+REF_DTYPE = struct_dtype("pyins_ref")
 #: The pyins_config fields, in the struct's order.
 CONFIG_FIELDS = tuple(name for name, _ in ffi.typeof("pyins_config").fields)
 
@@ -151,6 +153,19 @@ _STATUS_MEANING = {
                                     "PYINS_COARSE_EQ8",
     "PYINS_E_CONFIG_INTEGRITY": "integrity_nis_window must be -1 (off), 0 (default) or positive, "
                                 "integrity_nis_max and integrity_coarse_rad finite and not negative",
+    "PYINS_E_CONFIG_NAV": "nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, "
+                          "nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks "
+                          "1..10 s (0 = default)",
+    "PYINS_E_REF_KIND": "unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, "
+                        "ZERO_VEL are used)",
+    "PYINS_E_REF_VALUE": "a reference value is not finite (or a latitude beyond 90 deg), or its sigma is "
+                         "not finite and > 0; refused, state unchanged",
+    "PYINS_E_REF_ORDER": "a reference older than the last one pushed, or older than ref_max_latency_ticks "
+                         "before the current tick; refused, state unchanged",
+    "PYINS_E_REF_FUTURE": "a reference more than 10 s ahead of the current tick; refused, state unchanged",
+    "PYINS_E_REF_FULL": "the reference queue (8) is full: step the samples its references wait for first; "
+                        "refused, state unchanged",
+    "PYINS_E_REF_UNUSED": "nav_mode is UNDAMPED: the firmware takes no references",
     "PYINS_W_SEQ_GAP": "ticks missing before this sample: bridged (navigation) or alignment restarted; "
                        "sample taken",
     "PYINS_W_SEQ_REPEAT": "a sample already taken (seq repeated or behind): dropped, state unchanged",
@@ -195,6 +210,15 @@ class SampleError(CoreError, ValueError):
         self.outputs = outputs
         super().__init__(code, f"sample {index} rejected ({index} samples before it were "
                                f"accepted; the state is after them)")
+
+
+class RefError(CoreError, ValueError):
+    """The core refused a reference (``push_ref``): ``index`` is its position
+    in the array pushed; those before it were taken, the state is after them."""
+
+    def __init__(self, code, index):
+        self.index = index
+        super().__init__(code, f"reference {index} refused ({index} before it were taken)")
 
 
 class SnapshotError(CoreError, ValueError):
@@ -335,3 +359,45 @@ def check_samples(samples, contiguous=True):
     if contiguous and not samples.flags.c_contiguous:
         raise ValueError("samples: array is not C-contiguous (use numpy.ascontiguousarray)")
     return samples
+
+
+# --- external references ------------------------------------------------------
+#: pyins_ref_kind by the names the files and scenarios use.
+REF_KINDS = {"gnss_pos": 1, "gnss_vel": 2, "speed_log": 3, "dvl": 4, "zero_velocity": 5}
+
+
+def check_refs(refs):
+    """``refs`` as a 1-D C-contiguous REF_DTYPE array (one record is taken
+    as an array of one), else ValueError saying what is wrong. The values
+    themselves are the core's to check (pyins_push_ref)."""
+    if isinstance(refs, np.void) and refs.dtype == REF_DTYPE:
+        refs = np.array([refs], dtype=REF_DTYPE)
+    if not isinstance(refs, np.ndarray) or refs.dtype != REF_DTYPE:
+        got = refs.dtype if isinstance(refs, np.ndarray) else type(refs).__name__
+        raise ValueError(f"refs: expected an array of pyins.contract.REF_DTYPE, got {got} "
+                         f"(build one with pyins.contract.make_refs)")
+    if refs.ndim != 1:
+        raise ValueError(f"refs: shape is {refs.shape}, expected (N,)")
+    return np.ascontiguousarray(refs)
+
+
+def make_refs(kind, tick, value, sigma):
+    """A REF_DTYPE array from per-field arrays: kind (N,) ints or one kind
+    (a name of REF_KINDS or its number), tick (N,) ints, value and sigma
+    (N, 3) float64 in the units of pyins_ref_kind (lat, lon in rad)."""
+    tick = np.atleast_1d(np.asarray(tick))
+    if tick.ndim != 1 or not np.issubdtype(tick.dtype, np.integer):
+        raise ValueError(f"tick: expected integers (N,), got dtype {tick.dtype} shape {tick.shape}")
+    n = tick.shape[0]
+    if isinstance(kind, str):
+        if kind not in REF_KINDS:
+            raise ValueError(f"kind: unknown reference kind {kind!r} (known: {', '.join(REF_KINDS)})")
+        kind = REF_KINDS[kind]
+    refs = np.zeros(n, dtype=REF_DTYPE)
+    refs["kind"] = kind
+    refs["tick"] = tick
+    refs["value"] = as_float_array("value", np.atleast_2d(np.asarray(value, dtype=np.float64)), (3,),
+                                   contiguous=False)
+    refs["sigma"] = as_float_array("sigma", np.atleast_2d(np.asarray(sigma, dtype=np.float64)), (3,),
+                                   contiguous=False)
+    return refs

@@ -28,7 +28,7 @@ from . import contract
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 14)
+EXPECTED_ABI = (0, 15)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")
@@ -110,12 +110,14 @@ ffi, lib, LIBRARY_PATH, HAS_TEST_HOOKS, plant = _load()
 SAMPLE_DTYPE = contract.SAMPLE_DTYPE
 OUTPUT_DTYPE = contract.OUTPUT_DTYPE
 NAV_DTYPE = contract.NAV_DTYPE
+REF_DTYPE = contract.REF_DTYPE
 CONFIG_FIELDS = contract.CONFIG_FIELDS
 VERTICAL_MODES = contract.VERTICAL_MODES
 CoreError = contract.CoreError
 ConfigError = contract.ConfigError
 SampleError = contract.SampleError
 SnapshotError = contract.SnapshotError
+RefError = contract.RefError
 PlantError = contract.PlantError
 make_samples = contract.make_samples
 _SAMPLE_REJECTED = contract.SAMPLE_REJECTED
@@ -253,6 +255,17 @@ class Firmware:
         fw.config = {}
         fw.restore(blob)
         return fw
+
+    def push_ref(self, refs):
+        """Hand the firmware external references (a REF_DTYPE array or one
+        record), in order (pyins_push_ref). RefError at the first refused:
+        those before it were taken."""
+        refs = contract.check_refs(refs)
+        ptr = ffi.cast("pyins_ref *", ffi.from_buffer(refs))
+        for i in range(refs.shape[0]):
+            status = lib.pyins_push_ref(self._core, ptr + i)
+            if status != 0:
+                raise RefError(status, i)
 
     def index_reset(self):
         """Leave the indexing FAULT state (pyins_index_reset)."""

@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 14
+#define PYINS_ABI_VERSION_MINOR 15
 
 #ifdef __cplusplus
 extern "C" {
@@ -83,6 +83,14 @@ enum pyins_status {
     PYINS_E_CONFIG_LEVER = -35,       /* a lever-arm component not finite, or a lever arm longer than 100 m */
     PYINS_E_CONFIG_COARSE_METHOD = -36, /* unknown coarse_method */
     PYINS_E_CONFIG_INTEGRITY = -37,   /* integrity_nis_window below -1, or a bound negative or not finite */
+    PYINS_E_CONFIG_NAV = -38,         /* unknown nav_mode, or a navigation filter setting out of range */
+    PYINS_E_REF_KIND = -39,           /* a reference of an unknown kind (or one this build does not use yet) */
+    PYINS_E_REF_VALUE = -40,          /* a reference value not finite, or a sigma it uses not finite and > 0 */
+    PYINS_E_REF_ORDER = -41,          /* a reference older than the last one pushed, or older than
+                                         ref_max_latency_ticks before the current tick */
+    PYINS_E_REF_FUTURE = -42,         /* a reference more than 10 s ahead of the current tick */
+    PYINS_E_REF_FULL = -43,           /* the reference queue is full (step the samples it waits for first) */
+    PYINS_E_REF_UNUSED = -44,         /* nav_mode UNDAMPED: the firmware takes no references */
     PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
     PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
     PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
@@ -172,10 +180,49 @@ enum pyins_fault_flag {
     PYINS_FAULT_ALIGN_INCONSISTENT = 256, /* the fine alignment's measurements do not fit its model:
                                              a window's mean normalised innovation squared (align_nis)
                                              beyond integrity_nis_max; the attitude is not valid */
-    PYINS_FAULT_COARSE_UNSETTLED = 512 /* the coarse solution kept moving over the last fifth of the
+    PYINS_FAULT_COARSE_UNSETTLED = 512, /* the coarse solution kept moving over the last fifth of the
                                           coarse alignment by more than integrity_coarse_rad
                                           (coarse_wander_rad); the attitude is not valid */
+    PYINS_FAULT_REF_REJECTED = 1024 /* a reference kind failed its innovation gate nav_reject_limit times
+                                       in a row (n_ref_rejected): it is out of use (ref_in_use) until
+                                       one of its measurements fits again */
 };
+
+/* Navigation modes (pyins_config.nav_mode; pyins_output.nav_mode reports the
+ * one in effect, never AUTO). docs/concepts.md, "At sea". */
+enum pyins_nav_mode {
+    PYINS_NAV_AUTO = 0,           /* config: INTEGRATED while a reference is in use, else UNDAMPED,
+                                     the filter's covariance running throughout */
+    PYINS_NAV_UNDAMPED = 1,       /* free inertial navigation (the firmware of ABI 0.14): no filter,
+                                     references refused (PYINS_E_REF_UNUSED) */
+    PYINS_NAV_INTEGRATED = 3      /* the error-state Kalman filter corrects attitude, velocity,
+                                     position and the IMU biases from the references */
+};
+
+/* Kinds of external reference (pyins_ref.kind; the slot kind - 1 of the
+ * per-kind record arrays). Values on the IMU's clock, at the reference
+ * point (no antenna lever arm in ABI 0.15). */
+enum pyins_ref_kind {
+    PYINS_REF_GNSS_POS = 1,       /* value: [lat rad, lon rad, height m]; sigma: [E, N, U] m (U unused:
+                                     the vertical channel is held) */
+    PYINS_REF_GNSS_VEL = 2,       /* value: ENU velocity m/s; sigma: per axis m/s (U unused) */
+    PYINS_REF_SPEED_LOG = 3,      /* reserved: EM log speed through water (refused in ABI 0.15) */
+    PYINS_REF_DVL = 4,            /* reserved: DVL velocity (refused in ABI 0.15) */
+    PYINS_REF_ZERO_VEL = 5        /* the ship at rest: value 0; sigma: per axis m/s (U unused) */
+};
+
+/* One external reference measurement, valid at the end of IMU tick `tick`
+ * (the record's tick numbering). Pushed ahead of its tick it waits in the
+ * instance's queue (8 deep) and is applied when that tick is stepped; pushed
+ * late (up to ref_max_latency_ticks) it is applied at once, the position
+ * carried forward by the velocity over the latency. */
+typedef struct pyins_ref {
+    int32_t kind;                 /* enum pyins_ref_kind */
+    int32_t reserved;             /* ignored; keep 0 */
+    int64_t tick;                 /* tick at whose end the value holds */
+    double value[3];
+    double sigma[3];
+} pyins_ref;
 
 /* Sequence checking (pyins_config.seq_mode). */
 enum pyins_seq_mode {
@@ -193,7 +240,7 @@ enum pyins_mode {
 
 /* Bits of pyins_output.state_flags. */
 enum pyins_state_flag {
-    PYINS_STATE_ATT_VALID = 1     /* the attitude is a solution, not the configured guess nor a
+    PYINS_STATE_ATT_VALID = 1,    /* the attitude is a solution, not the configured guess nor a
                                      provisional one (coarse solutions until the coarse alignment
                                      has ended and passed its wander test; a fine estimate before
                                      the first NIS window has passed or while the filter's heading
@@ -201,6 +248,7 @@ enum pyins_state_flag {
                                      one), and no
                                      integrity test failed (PYINS_FAULT_ALIGN_INCONSISTENT,
                                      PYINS_FAULT_COARSE_UNSETTLED: once set, never valid again) */
+    PYINS_STATE_POS_AIDED = 2     /* a position reference was applied within the last 10 s */
 };
 
 /* Vertical channel: a marine INS holds height at the reference (external
@@ -283,6 +331,13 @@ typedef struct pyins_config {
                                      integrated random walk in the filter's Q and in the prior it
                                      takes from the coarse result (moving_align.hpp); >= 0,
                                      0 = a rigid site */
+    /* Navigation at sea (ABI 0.15; docs/concepts.md, "At sea"). */
+    int32_t nav_mode;             /* enum pyins_nav_mode; 0 = AUTO */
+    int32_t nav_every_ticks;      /* the navigation filter's time-update interval [ticks]; 0 = 1 s */
+    double nav_gate;              /* innovation gate on a 2-D reference's normalised innovation squared
+                                     (chi-square, 2 degrees of freedom); 0 = 13.8 (99.9 %) */
+    int32_t nav_reject_limit;     /* rejections in a row that put a kind out of use; 0 = 10 */
+    int32_t ref_max_latency_ticks; /* latest a reference may be pushed after its tick [ticks]; 0 = 1 s */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -349,6 +404,21 @@ typedef struct pyins_output {
     int32_t index_motor_starts;   /* motor starts since init: ticks whose commanded rate is non-zero
                                      after a tick whose commanded rate was 0 (ABI 0.13) */
     int32_t reserved1;
+    /* Navigation at sea (ABI 0.15). Per-kind arrays: slot kind - 1 (enum pyins_ref_kind). */
+    int32_t nav_mode;             /* enum pyins_nav_mode in effect (0 before NAVIGATE) */
+    uint32_t ref_in_use;          /* bit 1 << (kind - 1): a reference of that kind was applied within
+                                     the last 10 s and the kind is not out of use */
+    uint32_t n_ref_used[5];       /* references applied (passed their gate) */
+    uint32_t n_ref_rejected[5];   /* references that failed the innovation gate */
+    uint32_t n_ref_skipped[5];    /* references whose tick passed before navigation (alignment) */
+    int32_t reserved2;
+    double nav_nis[5];            /* the latest normalised innovation squared per kind (gated or not) */
+    double nav_sigma_pos_m;       /* the filter's horizontal position sigma sqrt(P_EE + P_NN) [m]
+                                     (0 without the filter) */
+    double nav_sigma_heading_rad; /* its heading sigma sqrt(P(phi_U)) [rad] */
+    double nav_gyro_bias_rad_s[3]; /* gyro biases estimated and compensated, in p [rad/s] */
+    double nav_accel_bias_mps2[3]; /* accelerometer biases estimated and compensated, in p (z: not
+                                     estimated, 0) [m/s^2] */
 } pyins_output;
 
 /* What the turntable's motor controller reads after every step, without
@@ -365,14 +435,16 @@ typedef struct pyins_motor_command {
  * replay or a closed loop at the full rate): the fields of pyins_output of
  * the same names, bit for bit, without the Euler angles, the heading, the
  * alignment filter's state and the counters, whose derivation costs as much
- * as the navigation tick (pyins_run_nav, pyins_get_nav). 160 bytes against
- * pyins_output's 448. */
+ * as the navigation tick (pyins_run_nav, pyins_get_nav). 168 bytes against
+ * pyins_output's 624. */
 typedef struct pyins_nav {
     int64_t tick;                 /* = pyins_output.tick */
     int32_t mode;                 /* = pyins_output.mode (enum pyins_mode) */
     uint32_t fault_flags;         /* = pyins_output.fault_flags */
     uint32_t state_flags;         /* = pyins_output.state_flags */
     int32_t index_state;          /* = pyins_output.index_state */
+    int32_t nav_mode;             /* = pyins_output.nav_mode (ABI 0.15) */
+    uint32_t ref_in_use;          /* = pyins_output.ref_in_use (ABI 0.15) */
     double lat_rad;               /* = pyins_output.lat_rad: the reference point's */
     double lon_rad;               /* = pyins_output.lon_rad */
     double height_m;              /* = pyins_output.height_m */
@@ -461,6 +533,13 @@ int pyins_run_decimated(pyins_core *core, const pyins_sample *samples, size_t n,
 int pyins_run_nav(pyins_core *core, const pyins_sample *samples, size_t n,
                   size_t out_every, pyins_nav *navs, size_t out_capacity,
                   size_t *n_done, size_t *n_out);
+
+/* Hand the firmware one external reference (struct pyins_ref). Checked
+ * whole before anything changes: an unknown kind, a non-finite value or
+ * sigma <= 0, a tick out of order, too late or too far ahead, a full queue
+ * or an UNDAMPED configuration is refused with its own status and leaves
+ * the state as it was. Returns PYINS_OK or a negative pyins_status. */
+int pyins_push_ref(pyins_core *core, const pyins_ref *ref);
 
 /* Leave the indexing FAULT state: the cycle starts again at its first step
  * from the measured table angle (A_c, A_s kept). Does nothing otherwise.

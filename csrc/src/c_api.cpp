@@ -17,7 +17,7 @@ using pyins::firmware::Firmware;
 
 static_assert(sizeof(pyins_sample) == 8 * sizeof(double), "pyins_sample layout");
 static_assert(sizeof(pyins_output) % 8 == 0, "pyins_output layout: arrays of records stay aligned");
-static_assert(sizeof(pyins_nav) == 160, "pyins_nav layout: arrays of records stay aligned");
+static_assert(sizeof(pyins_nav) == 168, "pyins_nav layout: arrays of records stay aligned");
 static_assert(alignof(Firmware) <= 16, "instance alignment");
 
 namespace {
@@ -43,7 +43,8 @@ int checked(const pyins_core* core, const Firmware** fw) {
 }
 
 constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
-constexpr uint32_t kSnapFormat = 3u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT
+constexpr uint32_t kSnapFormat = 4u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT;
+                                      // 4: the navigation filter and the reference queue
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
@@ -295,6 +296,18 @@ int pyins_index_reset(pyins_core* core) {
     return PYINS_OK;
 }
 
+int pyins_push_ref(pyins_core* core, const pyins_ref* ref) {
+    const Firmware* cfw = nullptr;
+    const int status = checked(core, &cfw);
+    if (status != PYINS_OK) {
+        return status;
+    }
+    if (ref == nullptr) {
+        return PYINS_E_NULL;
+    }
+    return const_cast<Firmware*>(cfw)->push_ref(*ref);
+}
+
 size_t pyins_snapshot_size(void) { return kSnapHeader + sizeof(Firmware); }
 
 int pyins_snapshot(const pyins_core* core, void* buf, size_t buf_size) {
@@ -434,6 +447,13 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m and lever_p_m must be finite and at most 100 m long";
         case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or PYINS_COARSE_EQ8";
         case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
+        case PYINS_E_CONFIG_NAV: return "PYINS_E_CONFIG_NAV: nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks 1..10 s (0 = default)";
+        case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, ZERO_VEL are used)";
+        case PYINS_E_REF_VALUE: return "PYINS_E_REF_VALUE: a reference value is not finite (or a latitude beyond 90 deg), or its sigma is not finite and > 0; refused, state unchanged";
+        case PYINS_E_REF_ORDER: return "PYINS_E_REF_ORDER: a reference older than the last one pushed, or older than ref_max_latency_ticks before the current tick; refused, state unchanged";
+        case PYINS_E_REF_FUTURE: return "PYINS_E_REF_FUTURE: a reference more than 10 s ahead of the current tick; refused, state unchanged";
+        case PYINS_E_REF_FULL: return "PYINS_E_REF_FULL: the reference queue (8) is full: step the samples its references wait for first; refused, state unchanged";
+        case PYINS_E_REF_UNUSED: return "PYINS_E_REF_UNUSED: nav_mode is UNDAMPED: the firmware takes no references";
         case PYINS_W_SEQ_GAP: return "PYINS_W_SEQ_GAP: ticks missing before this sample: bridged (navigation) or alignment restarted; sample taken";
         case PYINS_W_SEQ_REPEAT: return "PYINS_W_SEQ_REPEAT: a sample already taken (seq repeated or behind): dropped, state unchanged";
         case PYINS_W_SEQ_LOST: return "PYINS_W_SEQ_LOST: seq jumped beyond the bridgeable gap: sample taken without bridging, sequence resynchronised";

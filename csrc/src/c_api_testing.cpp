@@ -14,6 +14,7 @@
 #include "indexing.hpp"
 #include "math_portable.hpp"
 #include "moving_align.hpp"
+#include "nav_filter.hpp"
 #include "strapdown.hpp"
 
 namespace {
@@ -278,6 +279,84 @@ int pyins_t_moving_align_run(const pyins_t_moving_params* p, const double* dv_sf
         }
     }
     *nis_mean = m.nis_mean;
+    return updates;
+}
+
+namespace {
+pyins::nav_filter::Motion nav_motion6(const double* m) {
+    pyins::nav_filter::Motion mo;
+    mo.sin_lat = m[0];
+    mo.cos_lat = m[1];
+    mo.rm_h = m[2];
+    mo.rn_h = m[3];
+    mo.vel_e = m[4];
+    mo.vel_n = m[5];
+    return mo;
+}
+}  // namespace
+
+void pyins_t_nav_system_matrix(const double motion[6], const double f_n[3], const double c_np[9],
+                               double f_out[144]) {
+    const auto f = pyins::nav_filter::system_matrix(nav_motion6(motion), v3(f_n), m9(c_np));
+    for (int i = 0; i < 12; ++i) {
+        for (int j = 0; j < 12; ++j) {
+            f_out[12 * i + j] = f(i, j);
+        }
+    }
+}
+
+int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], const double* dv_sf_n,
+                           const double* motion, const double* c_np, const int32_t* kind,
+                           const double* z, const double* r, size_t n, double* nis, double* x_out,
+                           double* p_out, double* bias_out) {
+    namespace nf = pyins::nav_filter;
+    nf::Params prm;
+    prm.dt = p->dt;
+    prm.every = p->every;
+    prm.reject_limit = p->reject_limit;
+    prm.gyro_arw = p->gyro_arw;
+    prm.accel_vrw = p->accel_vrw;
+    prm.gate = p->gate;
+    for (int i = 0; i < 3; ++i) {
+        prm.sigma0_att[i] = p->sigma0_att[i];
+    }
+    prm.sigma0_vel = p->sigma0_vel;
+    prm.sigma0_pos = p->sigma0_pos;
+    prm.sigma0_gyro = p->sigma0_gyro;
+    prm.sigma0_accel = p->sigma0_accel;
+    nf::NavFilter f;
+    nf::init(f, prm, m9(c_np0));
+    int updates = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const nf::Motion mo = nav_motion6(motion + 6 * k);
+        const Mat3 c = m9(c_np + 9 * k);
+        nf::gather(f, v3(dv_sf_n + 3 * k));
+        if (f.ticks == f.prm.every) {
+            nf::predict(f, mo, c);
+        }
+        nis[k] = 0.0;
+        if (kind[k] != 0) {
+            nf::predict(f, mo, c);
+            const int row = kind[k] == 1 ? nf::kPos : nf::kVel;
+            nis[k] = nf::nis_pair(f, row, z + 2 * k, r + 2 * k);
+            if (nis[k] <= prm.gate) {
+                nf::update_pair(f, row, z + 2 * k, r + 2 * k);
+                nf::reset_feedback(f);
+                f.c_start = c;
+                updates = updates + 1;
+            }
+        }
+    }
+    for (int i = 0; i < 12; ++i) {
+        x_out[i] = f.x(i);
+        for (int j = 0; j < 12; ++j) {
+            p_out[12 * i + j] = f.p(i, j);
+        }
+    }
+    for (int i = 0; i < 3; ++i) {
+        bias_out[i] = f.gyro_bias(i);
+        bias_out[3 + i] = f.accel_bias(i);
+    }
     return updates;
 }
 

@@ -111,6 +111,18 @@ pyins_config config_resolved(const pyins_config& in) {
     if (cfg.integrity_coarse_rad == 0.0) {
         cfg.integrity_coarse_rad = kDefaultCoarseWander;
     }
+    if (cfg.nav_every_ticks == 0) {
+        cfg.nav_every_ticks = kDefaultNavEveryS * cfg.tick_hz;
+    }
+    if (cfg.nav_gate == 0.0) {
+        cfg.nav_gate = kDefaultNavGate;
+    }
+    if (cfg.nav_reject_limit == 0) {
+        cfg.nav_reject_limit = kDefaultNavRejectLimit;
+    }
+    if (cfg.ref_max_latency_ticks == 0) {
+        cfg.ref_max_latency_ticks = kDefaultRefLatencyS * cfg.tick_hz;
+    }
     return cfg;
 }
 
@@ -263,6 +275,13 @@ int config_check(const pyins_config& raw) {
         !std::isfinite(cfg.integrity_nis_max) || !(cfg.integrity_coarse_rad > 0.0) ||
         !std::isfinite(cfg.integrity_coarse_rad)) {
         return PYINS_E_CONFIG_INTEGRITY;
+    }
+    if ((cfg.nav_mode != PYINS_NAV_AUTO && cfg.nav_mode != PYINS_NAV_UNDAMPED &&
+         cfg.nav_mode != PYINS_NAV_INTEGRATED) ||
+        cfg.nav_every_ticks < 1 || cfg.nav_every_ticks > kMaxNavEveryS * cfg.tick_hz ||
+        !(cfg.nav_gate > 0.0) || !std::isfinite(cfg.nav_gate) || cfg.nav_reject_limit < 1 ||
+        cfg.ref_max_latency_ticks < 1 || cfg.ref_max_latency_ticks > kRefHorizonS * cfg.tick_hz) {
+        return PYINS_E_CONFIG_NAV;
     }
     return PYINS_OK;
 }

@@ -77,6 +77,27 @@ inline constexpr int32_t kDefaultNisWindow = 100;
 inline constexpr double kDefaultNisMax = 4.0;
 inline constexpr double kDefaultCoarseWander = 30.0 * kArcminToRad;
 
+/// Navigation at sea (docs/concepts.md, "At sea"): the filter's time update
+/// once a second (the Schuler period is 84 min: the linearisation's error
+/// over 1 s is 1e-6 of the state's); the gate at chi-square(2) 99.9 % (a
+/// consistent filter rejects one good pair in 1,000); 10 rejections in a
+/// row put a kind out of use (10 s of GNSS: a multipath jump lasts one or
+/// two fixes, a frozen or offset receiver stays); a reference may arrive up
+/// to 1 s after its tick (a receiver's latency is 20-200 ms) and be pushed
+/// up to 10 s before it (the queue holds 8).
+inline constexpr int32_t kDefaultNavEveryS = 1;
+inline constexpr int32_t kMaxNavEveryS = 10;
+inline constexpr double kDefaultNavGate = 13.8155;   ///< -2 ln(0.001)
+inline constexpr int32_t kDefaultNavRejectLimit = 10;
+inline constexpr int32_t kDefaultRefLatencyS = 1;
+inline constexpr int32_t kRefHorizonS = 10;
+/// Initial sigmas of the navigation filter's position and velocity when
+/// navigation starts from an alignment at the site [m, m/s] (the site's
+/// survey; the alignment's velocity residual), and of its attitude when no
+/// fine alignment ran [rad].
+inline constexpr double kNavSigma0Pos = 10.0;
+inline constexpr double kNavSigma0Vel = 0.1;
+
 /// 2. Fill *cfg with the defaults (equal to a zeroed config).
 void config_default(pyins_config* cfg);
 

@@ -21,11 +21,6 @@ bool within(const double v[3], double limit) {
     return std::fabs(v[0]) < limit && std::fabs(v[1]) < limit && std::fabs(v[2]) < limit;
 }
 
-/// counter + n, saturating at 2^32 - 1 (a counter never wraps to look healthy).
-void count(uint32_t* counter, uint32_t n) {
-    *counter = n > 0xFFFFFFFFu - *counter ? 0xFFFFFFFFu : *counter + n;
-}
-
 }  // namespace
 
 void Firmware::init(const pyins_config& raw) {
@@ -73,6 +68,21 @@ void Firmware::init(const pyins_config& raw) {
     lever_vel_n_ = Vec3::Zero();
     lever_refine_ = 0;
     integrity_lost_ = 0;
+    nav_on_ = 0;
+    refq_head_ = 0;
+    refq_count_ = 0;
+    reserved_nav_ = 0;
+    ref_last_tick_ = -1;
+    for (int32_t i = 0; i < kRefKinds; ++i) {
+        n_ref_used_[i] = 0u;
+        n_ref_rejected_[i] = 0u;
+        n_ref_skipped_[i] = 0u;
+        ref_reject_run_[i] = 0;
+        ref_out_[i] = 0;
+        ref_used_tick_[i] = -1;
+        nav_nis_[i] = 0.0;
+    }
+    reserved_ref_ = 0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
     coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 
@@ -140,7 +150,11 @@ void Firmware::init(const pyins_config& raw) {
 void Firmware::start_navigation() {
     mode_ = Mode::kNavigate;
     indexing::init(idx_, index_prm_, table_angle_);
+    if (cfg_.nav_mode != PYINS_NAV_UNDAMPED) {
+        start_nav_filter();
+    }
 }
+
 
 void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
     // q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]
@@ -715,7 +729,14 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
     } else if (mode_ == Mode::kFineAlign) {
         fine_tick(dtheta_p, dv_p);
     } else {
-        strapdown::update(sd_, dtheta_p, dv_p, dt_);
+        if (nav_on_ != 0) {
+            // the biases the filter estimated, compensated (0 until it has)
+            const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p - nav_.gyro_bias * dt_,
+                                                   dv_p - nav_.accel_bias * dt_, dt_);
+            nav_tick(dv_sf_n);
+        } else {
+            strapdown::update(sd_, dtheta_p, dv_p, dt_);
+        }
         if (index_prm_.n_steps > 0) {
             double sin_yaw_p = 0.0;
             double cos_yaw_p = 0.0;
@@ -725,8 +746,11 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
             indexing::update(idx_, table_angle_, sin_yaw_p, cos_yaw_p);
         }
     }
-    // 6. The tick.
+    // 6. The tick, and the references that belong to it.
     tick_ = tick_ + 1;
+    if (refq_count_ > 0) {
+        refs_due();
+    }
 }
 
 void Firmware::motor_command(pyins_motor_command* cmd) const {
@@ -776,6 +800,9 @@ PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* heigh
         }
     }
     *state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
+    if (mode_ == Mode::kNavigate && (refs_in_use() & (1u << (PYINS_REF_GNSS_POS - 1))) != 0u) {
+        *state_flags = *state_flags | static_cast<uint32_t>(PYINS_STATE_POS_AIDED);
+    }
     const Quat q_nb = attitude::quat_renormalize(attitude::quat_mul_z(q_np, enc_cos_half_, -enc_sin_half_));
     quat_np[0] = q_np.w;
     quat_np[1] = q_np.x;
@@ -794,6 +821,8 @@ PYINS_HOT_INLINE void Firmware::fill_nav(pyins_nav* nav) const {
     nav->mode = static_cast<int32_t>(mode_);
     nav->fault_flags = faults_;
     nav->index_state = static_cast<int32_t>(idx_.state);
+    nav->nav_mode = nav_mode_now();
+    nav->ref_in_use = mode_ == Mode::kNavigate ? refs_in_use() : 0u;
     solution(&nav->lat_rad, &nav->lon_rad, &nav->height_m, nav->vel_n_mps, nav->quat_np, nav->quat_nb,
              &nav->state_flags);
     nav->table_angle_rad = table_angle_;
@@ -846,6 +875,24 @@ void Firmware::output(pyins_output* out) const {
         out->kf_sigma[i] = 0.0;
     }
     fine_.record(out->kf_x, out->kf_sigma);
+    out->nav_mode = nav_mode_now();
+    out->ref_in_use = mode_ == Mode::kNavigate ? refs_in_use() : 0u;
+    for (int32_t i = 0; i < kRefKinds; ++i) {
+        out->n_ref_used[i] = n_ref_used_[i];
+        out->n_ref_rejected[i] = n_ref_rejected_[i];
+        out->n_ref_skipped[i] = n_ref_skipped_[i];
+        out->nav_nis[i] = nav_nis_[i];
+    }
+    out->reserved2 = 0;
+    const bool filter = nav_on_ != 0;
+    out->nav_sigma_pos_m = filter ? pmath::sqrt(nav_.p(nav_filter::kPos, nav_filter::kPos) +
+                                                nav_.p(nav_filter::kPos + 1, nav_filter::kPos + 1))
+                                  : 0.0;
+    out->nav_sigma_heading_rad = filter ? pmath::sqrt(nav_.p(nav_filter::kPhi + 2, nav_filter::kPhi + 2)) : 0.0;
+    for (int i = 0; i < 3; ++i) {
+        out->nav_gyro_bias_rad_s[i] = filter ? nav_.gyro_bias(i) : 0.0;
+        out->nav_accel_bias_mps2[i] = filter ? nav_.accel_bias(i) : 0.0;
+    }
 }
 
 }  // namespace pyins::firmware

@@ -13,6 +13,7 @@
 #include "coarse_align.hpp"
 #include "fine_filter.hpp"
 #include "indexing.hpp"
+#include "nav_filter.hpp"
 #include "strapdown.hpp"
 #include "types.hpp"
 #include "units.hpp"
@@ -32,6 +33,11 @@ enum class Mode : int32_t {
 /// wide prior the heading wanders far while its sigma is still large
 /// (docs/concepts.md, "Integrity": PSINS's real laser-gyro log).
 inline constexpr double kValidHeadingSigma = 10.0 * kArcminToRad;
+/// The reference queue's depth (pyins_push_ref) and the kinds' slots.
+inline constexpr int32_t kRefQueue = 8;
+inline constexpr int32_t kRefKinds = 5;
+/// A kind is in use while one of its references was applied within this [s].
+inline constexpr int32_t kRefInUseS = 10;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -45,6 +51,11 @@ struct SampleCounts {
     uint32_t seq_lost;
     uint32_t encoder_jumps;
 };
+
+/// counter + n, saturating at 2^32 - 1 (a counter never wraps to look healthy).
+inline void count(uint32_t* counter, uint32_t n) {
+    *counter = n > 0xFFFFFFFFu - *counter ? 0xFFFFFFFFu : *counter + n;
+}
 
 /// How a sample's seq follows the last one taken (PYINS_SEQ_CHECK).
 enum class SeqKind : int32_t { kNext = 0, kGap = 1, kRepeat = 2, kLost = 3 };
@@ -92,6 +103,11 @@ class Firmware {
 
     /// Leave the indexing FAULT state (pyins_index_reset).
     void index_reset();
+
+    /// One external reference (pyins_push_ref): checked whole, then applied
+    /// now (its tick has passed: latency compensated) or queued for its tick.
+    /// Returns PYINS_OK or a negative PYINS_E_REF_* status (state unchanged).
+    int push_ref(const pyins_ref& ref);
 
     uint32_t magic() const { return magic_; }
     /// Byte offset of the marker inside the instance (for snapshots).
@@ -178,6 +194,21 @@ class Firmware {
     /// the site, and the lever arm's share taken out of the tick's specific
     /// force in n, *dv_sf_n [m/s].
     void hold_static_base(Vec3* dv_sf_n);
+    /// Start the navigation filter (NAVIGATE, nav_mode not UNDAMPED).
+    void start_nav_filter();
+    /// The filter's linearisation point now.
+    nav_filter::Motion nav_motion() const;
+    /// Navigation filter work of a NAVIGATE tick, after the strapdown.
+    void nav_tick(const Vec3& dv_sf_n);
+    /// Apply the references whose tick has come (tick_ just advanced).
+    void refs_due();
+    /// Gate and apply one reference now (lag: ticks since its tick).
+    void apply_ref(const pyins_ref& ref, int64_t lag);
+    /// The navigation mode in effect (pyins_output.nav_mode).
+    int32_t nav_mode_now() const;
+    /// ref_in_use's bits.
+    uint32_t refs_in_use() const;
+
     /// Put the navigation state on the accelerometers of a reference point
     /// at (lat, lon, height) moving with vel_n, with the current attitude.
     void place_imu(double lat, double lon, double height, const Vec3& vel_n);
@@ -218,6 +249,22 @@ class Firmware {
     int32_t lever_refine_;        ///< 1: navigation started from the configured state last tick
     int32_t integrity_lost_;      ///< 1: an integrity test failed: the attitude is never valid again
     double coarse_wander_max_;    ///< sine of integrity_coarse_rad
+    // Navigation at sea (nav_filter.hpp).
+    int32_t nav_on_;              ///< 1: the navigation filter runs (NAVIGATE, not UNDAMPED)
+    int32_t refq_head_;           ///< index of the oldest queued reference
+    int32_t refq_count_;          ///< references queued
+    int32_t reserved_nav_;        ///< (keeps the layout free of padding)
+    int64_t ref_last_tick_;       ///< tick of the last reference pushed (-1: none)
+    pyins_ref refq_[kRefQueue];   ///< the queue, a ring
+    nav_filter::NavFilter nav_;
+    uint32_t n_ref_used_[kRefKinds];
+    uint32_t n_ref_rejected_[kRefKinds];
+    uint32_t n_ref_skipped_[kRefKinds];
+    int32_t ref_reject_run_[kRefKinds];   ///< rejections in a row
+    int32_t ref_out_[kRefKinds];          ///< 1: out of use (nav_reject_limit reached)
+    int32_t reserved_ref_;                ///< (keeps the layout free of padding)
+    int64_t ref_used_tick_[kRefKinds];    ///< tick of the last applied (-1: none)
+    double nav_nis_[kRefKinds];
 };
 
 }  // namespace pyins::firmware

@@ -45,6 +45,13 @@ PYINS_E_CONFIG_INDEX_SUMS = -34
 PYINS_E_CONFIG_LEVER = -35
 PYINS_E_CONFIG_COARSE_METHOD = -36
 PYINS_E_CONFIG_INTEGRITY = -37
+PYINS_E_CONFIG_NAV = -38
+PYINS_E_REF_KIND = -39
+PYINS_E_REF_VALUE = -40
+PYINS_E_REF_ORDER = -41
+PYINS_E_REF_FUTURE = -42
+PYINS_E_REF_FULL = -43
+PYINS_E_REF_UNUSED = -44
 PYINS_W_SEQ_GAP = 1          # notices: the sample was handled (docs/core.md)
 PYINS_W_SEQ_REPEAT = 2
 PYINS_W_SEQ_LOST = 3
@@ -99,6 +106,19 @@ PYINS_FAULT_SEQ_LOST = 64
 PYINS_FAULT_ENCODER_JUMP = 128
 PYINS_FAULT_ALIGN_INCONSISTENT = 256
 PYINS_FAULT_COARSE_UNSETTLED = 512
+PYINS_FAULT_REF_REJECTED = 1024
+
+# --- enum pyins_nav_mode ----------------------------------------------------
+PYINS_NAV_AUTO = 0
+PYINS_NAV_UNDAMPED = 1
+PYINS_NAV_INTEGRATED = 3
+
+# --- enum pyins_ref_kind ----------------------------------------------------
+PYINS_REF_GNSS_POS = 1
+PYINS_REF_GNSS_VEL = 2
+PYINS_REF_SPEED_LOG = 3
+PYINS_REF_DVL = 4
+PYINS_REF_ZERO_VEL = 5
 
 # --- enum pyins_seq_mode ----------------------------------------------------
 PYINS_SEQ_OFF = 0
@@ -112,6 +132,7 @@ PYINS_MODE_NAVIGATE = 3
 
 # --- enum pyins_state_flag: bits of pyins_output.state_flags ----------------
 PYINS_STATE_ATT_VALID = 1
+PYINS_STATE_POS_AIDED = 2
 
 # --- enum pyins_vertical_mode -----------------------------------------------
 PYINS_VERTICAL_HOLD = 0
@@ -136,7 +157,9 @@ ENUMS = {
         ("pyins_fault_flag", [n for n in dir() if n.startswith("PYINS_FAULT_")]),
         ("pyins_seq_mode", ["PYINS_SEQ_OFF", "PYINS_SEQ_CHECK"]),
         ("pyins_mode", [n for n in dir() if n.startswith("PYINS_MODE_")]),
-        ("pyins_state_flag", ["PYINS_STATE_ATT_VALID"]),
+        ("pyins_nav_mode", ["PYINS_NAV_AUTO", "PYINS_NAV_UNDAMPED", "PYINS_NAV_INTEGRATED"]),
+        ("pyins_ref_kind", [n for n in dir() if n.startswith("PYINS_REF_")]),
+        ("pyins_state_flag", ["PYINS_STATE_ATT_VALID", "PYINS_STATE_POS_AIDED"]),
         ("pyins_vertical_mode", ["PYINS_VERTICAL_HOLD", "PYINS_VERTICAL_FREE"]),
     )
 }

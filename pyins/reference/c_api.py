@@ -158,6 +158,11 @@ def pyins_index_reset(fw):
     return abi.PYINS_OK
 
 
+def pyins_push_ref(fw, ref):
+    """One REF_DTYPE record (mirrors pyins_push_ref)."""
+    return fw.push_ref(int(ref["kind"]), int(ref["tick"]), ref["value"], ref["sigma"])
+
+
 def _records(status, n_done, records, dtype):
     """The record dicts of a decimated run as an array of ``dtype``;
     SampleError (carrying them) when the run stopped at a rejected sample."""
@@ -260,6 +265,14 @@ class Firmware:
     def index_reset(self):
         """Leave the indexing FAULT state (pyins_index_reset)."""
         pyins_index_reset(self._fw)
+
+    def push_ref(self, refs):
+        """External references, in order (see ``native.Firmware.push_ref``)."""
+        refs = contract.check_refs(refs)
+        for i in range(refs.shape[0]):
+            status = pyins_push_ref(self._fw, refs[i])
+            if status != abi.PYINS_OK:
+                raise contract.RefError(status, i)
 
     def snapshot(self):
         """The whole reference state as a checksummed blob (bytes)."""

@@ -48,6 +48,14 @@ DEFAULT_SEQ_MAX_GAP = 2                      #: kDefaultSeqMaxGap [ticks]
 DEFAULT_NIS_WINDOW = 100                     #: kDefaultNisWindow
 DEFAULT_NIS_MAX = 4.0                        #: kDefaultNisMax
 DEFAULT_COARSE_WANDER = 30.0 * ARCMIN_TO_RAD  #: kDefaultCoarseWander
+DEFAULT_NAV_EVERY_S = 1                      #: kDefaultNavEveryS
+MAX_NAV_EVERY_S = 10                         #: kMaxNavEveryS
+DEFAULT_NAV_GATE = 13.8155                   #: kDefaultNavGate: -2 ln(0.001)
+DEFAULT_NAV_REJECT_LIMIT = 10                #: kDefaultNavRejectLimit
+DEFAULT_REF_LATENCY_S = 1                    #: kDefaultRefLatencyS
+REF_HORIZON_S = 10                           #: kRefHorizonS
+NAV_SIGMA0_POS = 10.0                        #: kNavSigma0Pos [m]
+NAV_SIGMA0_VEL = 0.1                         #: kNavSigma0Vel [m/s]
 
 # --- the limits the checks hold a configuration to ---------------------------
 MAX_TICK_HZ = 10000                 #: kMaxTickHz
@@ -110,6 +118,11 @@ def config_default():
         "fine_pos_sigma_m": 0.0,
         "fine_sigma0_vel_mps": 0.0,
         "fine_site_accel": 0.0,
+        "nav_mode": abi.PYINS_NAV_AUTO,
+        "nav_every_ticks": 0,
+        "nav_gate": 0.0,
+        "nav_reject_limit": 0,
+        "ref_max_latency_ticks": 0,
     }
 
 
@@ -178,6 +191,14 @@ def config_resolved(cfg):
         cfg["integrity_nis_max"] = DEFAULT_NIS_MAX
     if cfg["integrity_coarse_rad"] == 0.0:
         cfg["integrity_coarse_rad"] = DEFAULT_COARSE_WANDER
+    if cfg["nav_every_ticks"] == 0:
+        cfg["nav_every_ticks"] = DEFAULT_NAV_EVERY_S * cfg["tick_hz"]
+    if cfg["nav_gate"] == 0.0:
+        cfg["nav_gate"] = DEFAULT_NAV_GATE
+    if cfg["nav_reject_limit"] == 0:
+        cfg["nav_reject_limit"] = DEFAULT_NAV_REJECT_LIMIT
+    if cfg["ref_max_latency_ticks"] == 0:
+        cfg["ref_max_latency_ticks"] = DEFAULT_REF_LATENCY_S * cfg["tick_hz"]
     return cfg
 
 
@@ -288,5 +309,12 @@ def config_check(raw):
     if (cfg["integrity_nis_window"] < -1 or not (nis_max > 0.0) or not math.isfinite(nis_max)
             or not (wander > 0.0) or not math.isfinite(wander)):
         return abi.PYINS_E_CONFIG_INTEGRITY
+    hz = cfg["tick_hz"]
+    if (cfg["nav_mode"] not in (abi.PYINS_NAV_AUTO, abi.PYINS_NAV_UNDAMPED, abi.PYINS_NAV_INTEGRATED)
+            or not 1 <= cfg["nav_every_ticks"] <= MAX_NAV_EVERY_S * hz
+            or not (cfg["nav_gate"] > 0.0) or not math.isfinite(cfg["nav_gate"])
+            or cfg["nav_reject_limit"] < 1
+            or not 1 <= cfg["ref_max_latency_ticks"] <= REF_HORIZON_S * hz):
+        return abi.PYINS_E_CONFIG_NAV
     return abi.PYINS_OK
 

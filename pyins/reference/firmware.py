@@ -21,6 +21,7 @@ from . import abi, attitude, coarse_align, config, earth, fine_align, indexing, 
 from .angle import wrap_pi, wrap_two_pi
 from .attitude import cross
 from .config import finite3
+from .firmware_nav import NavAtSea
 
 SEQ_NEXT, SEQ_GAP, SEQ_REPEAT, SEQ_LOST = 0, 1, 2, 3   #: SeqKind
 U32 = 0xFFFFFFFF
@@ -42,7 +43,7 @@ def count(counter, n=1):
     return U32 if n > U32 - counter else counter + n
 
 
-class Firmware:
+class Firmware(NavAtSea):
     """NumPy mirror of ``pyins::firmware::Firmware``.
 
     ``Firmware(cfg)`` with a dict like :func:`config.config_default`; raises
@@ -98,6 +99,7 @@ class Firmware:
         self.lever_vel_n = np.zeros(3)
         self.lever_refine = 0
         self.integrity_lost = 0
+        self.init_nav()
         self.fine_vrw = 0.0
         wander = cfg["integrity_coarse_rad"]
         self.coarse_wander_max = 1.0 if wander >= 0.5 * np.pi else math.sin(wander)
@@ -139,6 +141,8 @@ class Firmware:
     def start_navigation(self):
         self.mode = abi.PYINS_MODE_NAVIGATE
         self.idx = indexing.init(self.index_prm, self.table_angle)
+        if self.cfg["nav_mode"] != abi.PYINS_NAV_UNDAMPED:
+            self.start_nav_filter()
 
     def imu_yaw_sincos(self):
         """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors
@@ -554,14 +558,22 @@ class Firmware:
             if self.fine_tick == self.cfg["fine_ticks"]:
                 self.end_fine()
         else:
-            strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
+            if self.nav_on:
+                # the biases the filter estimated, compensated (0 until it has)
+                dv_sf_n = strapdown.update(self.sd, dtheta_p - self.nav.gyro_bias * self.dt,
+                                           dv_p - self.nav.accel_bias * self.dt, self.dt)
+                self.nav_tick(dv_sf_n)
+            else:
+                strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
             if self.index_prm.n_steps > 0:
                 sn = cs = 0.0
                 if indexing.wants_heading(self.idx):
                     sn, cs = self.imu_yaw_sincos()
                 indexing.update(self.idx, self.table_angle, sn, cs)
-        # 6. The tick.
+        # 6. The tick, and the references that belong to it.
         self.tick = self.tick + 1
+        if self.refq:
+            self.refs_due()
 
     def solution(self):
         """(lat, lon, height, vel, q_np, q_nb, state_flags): what output()
@@ -584,6 +596,8 @@ class Firmware:
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
         state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
+        if self.mode == abi.PYINS_MODE_NAVIGATE and self.refs_in_use() & (1 << (abi.PYINS_REF_GNSS_POS - 1)):
+            state_flags = state_flags | abi.PYINS_STATE_POS_AIDED
         q_nb = attitude.quat_renormalize(attitude.quat_mul_z(q_np, self.enc_cos_half, -self.enc_sin_half))
         return lat, lon, height, vel, q_np.copy(), q_nb, state_flags
 
@@ -595,6 +609,8 @@ class Firmware:
             "fault_flags": self.faults,
             "state_flags": state_flags,
             "index_state": self.idx.state,
+            "nav_mode": self.nav_mode_now(),
+            "ref_in_use": self.refs_in_use() if self.mode == abi.PYINS_MODE_NAVIGATE else 0,
             "lat_rad": lat,
             "lon_rad": lon,
             "height_m": height,
@@ -631,6 +647,7 @@ class Firmware:
             "fine_vrw": self.fine_vrw if self.kf_states in (5, 8) else 0.0,
             "kf_x": self._kf(lambda f: f.x),
             "kf_sigma": self._kf(lambda f: np.sqrt(np.diag(f.p))),
+            **self.nav_output(),
         }
 
     def _kf(self, get):

@@ -1,0 +1,202 @@
+// firmware_nav.cpp: the firmware at sea: the navigation filter beside the
+// strapdown in NAVIGATE and the external references (pyins_push_ref), the
+// Firmware members firmware.hpp declares under "Navigation at sea".
+// Mirrored by pyins/reference/firmware_nav.py; the filter is nav_filter.hpp.
+#include <cmath>
+
+#include "angle.hpp"
+#include "attitude.hpp"
+#include "config.hpp"
+#include "earth.hpp"
+#include "firmware.hpp"
+#include "math_portable.hpp"
+
+namespace pyins::firmware {
+
+using angle::wrap_pi;
+
+void Firmware::start_nav_filter() {
+    // The prior: the fine filter's attitude sigmas when one ran, else the
+    // configured attitude sigmas (the defaults when left 0); the site's
+    // position and the alignment's velocity residual (config.hpp).
+    nav_filter::Params prm;
+    prm.dt = dt_;
+    prm.every = cfg_.nav_every_ticks;
+    prm.reject_limit = cfg_.nav_reject_limit;
+    prm.gyro_arw = cfg_.fine_gyro_arw;
+    prm.accel_vrw = cfg_.fine_accel_vrw;
+    prm.gate = cfg_.nav_gate;
+    double kf_x[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    double kf_sigma[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    fine_.record(kf_x, kf_sigma);
+    for (int i = 0; i < 3; ++i) {
+        const double configured = cfg_.fine_sigma0_att_rad[i] > 0.0 ? cfg_.fine_sigma0_att_rad[i]
+                                                                    : config::kDefaultFineSigmaAtt[i];
+        prm.sigma0_att[i] = fine_.states() != 0 ? kf_sigma[i] : configured;
+    }
+    prm.sigma0_vel = config::kNavSigma0Vel;
+    prm.sigma0_pos = config::kNavSigma0Pos;
+    prm.sigma0_gyro = cfg_.fine_sigma0_gyro;
+    prm.sigma0_accel = cfg_.fine_sigma0_accel;
+    nav_filter::init(nav_, prm, attitude::quat_to_mat(sd_.nav.quat_np));
+    nav_on_ = 1;
+}
+
+nav_filter::Motion Firmware::nav_motion() const {
+    nav_filter::Motion m;
+    pmath::sincos(sd_.nav.lat, &m.sin_lat, &m.cos_lat);
+    const earth::PrincipalRadii r = earth::principal_radii(m.sin_lat);
+    m.rm_h = r.rm + sd_.nav.height;
+    m.rn_h = r.rn + sd_.nav.height;
+    m.vel_e = sd_.nav.vel_n(0);
+    m.vel_n = sd_.nav.vel_n(1);
+    return m;
+}
+
+void Firmware::nav_tick(const Vec3& dv_sf_n) {
+    nav_filter::gather(nav_, dv_sf_n);
+    if (nav_.ticks == nav_.prm.every) {
+        nav_filter::predict(nav_, nav_motion(), attitude::quat_to_mat(sd_.nav.quat_np));
+        if (nav_.healthy == 0) {
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
+        }
+    }
+}
+
+int Firmware::push_ref(const pyins_ref& ref) {
+    if (cfg_.nav_mode == PYINS_NAV_UNDAMPED) {
+        return PYINS_E_REF_UNUSED;
+    }
+    if (ref.kind != PYINS_REF_GNSS_POS && ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_ZERO_VEL) {
+        return PYINS_E_REF_KIND;
+    }
+    // the vertical is held: sigma[2] is not used, nor checked
+    if (!std::isfinite(ref.value[0]) || !std::isfinite(ref.value[1]) || !std::isfinite(ref.value[2]) ||
+        !(ref.sigma[0] > 0.0) || !(ref.sigma[1] > 0.0) || !std::isfinite(ref.sigma[0]) ||
+        !std::isfinite(ref.sigma[1]) ||
+        (ref.kind == PYINS_REF_GNSS_POS && !(std::fabs(ref.value[0]) <= 0.5 * kPi))) {
+        return PYINS_E_REF_VALUE;
+    }
+    if (ref.tick < ref_last_tick_ || ref.tick < tick_ - static_cast<int64_t>(cfg_.ref_max_latency_ticks)) {
+        return PYINS_E_REF_ORDER;
+    }
+    if (ref.tick > tick_ + static_cast<int64_t>(config::kRefHorizonS) * cfg_.tick_hz) {
+        return PYINS_E_REF_FUTURE;
+    }
+    if (ref.tick > tick_) {
+        if (refq_count_ == kRefQueue) {
+            return PYINS_E_REF_FULL;
+        }
+        pyins_ref& slot = refq_[(refq_head_ + refq_count_) % kRefQueue];
+        slot = ref;
+        slot.reserved = 0;
+        refq_count_ = refq_count_ + 1;
+        ref_last_tick_ = ref.tick;
+        return PYINS_OK;
+    }
+    // its tick has passed: now, the latency compensated
+    ref_last_tick_ = ref.tick;
+    if (mode_ == Mode::kNavigate && nav_on_ != 0) {
+        apply_ref(ref, tick_ - ref.tick);
+    } else {
+        count(&n_ref_skipped_[ref.kind - 1], 1u);
+    }
+    return PYINS_OK;
+}
+
+void Firmware::refs_due() {
+    while (refq_count_ > 0 && refq_[refq_head_].tick <= tick_) {
+        const pyins_ref& ref = refq_[refq_head_];
+        if (mode_ == Mode::kNavigate && nav_on_ != 0) {
+            apply_ref(ref, tick_ - ref.tick);
+        } else {
+            count(&n_ref_skipped_[ref.kind - 1], 1u);
+        }
+        refq_head_ = (refq_head_ + 1) % kRefQueue;
+        refq_count_ = refq_count_ - 1;
+    }
+}
+
+void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
+    const int32_t slot = ref.kind - 1;
+    const nav_filter::Motion m = nav_motion();
+    // the time update up to this tick first
+    nav_filter::predict(nav_, m, attitude::quat_to_mat(sd_.nav.quat_np));
+    double lat = sd_.nav.lat;
+    double lon = sd_.nav.lon;
+    double height = sd_.nav.height;
+    Vec3 vel = sd_.nav.vel_n;
+    if (has_lever_ != 0) {
+        reference_point(&lat, &lon, &height, &vel);
+    }
+    // z = computed - reference, on the unit rows of dp or dv
+    double z[2];
+    const double r[2] = {ref.sigma[0] * ref.sigma[0], ref.sigma[1] * ref.sigma[1]};
+    int k = nav_filter::kVel;
+    if (ref.kind == PYINS_REF_GNSS_POS) {
+        // carried to this tick by the velocity over the latency
+        const double lag_s = static_cast<double>(lag) * dt_;
+        z[0] = wrap_pi(lon - ref.value[1]) * m.rn_h * m.cos_lat - vel(0) * lag_s;
+        z[1] = (lat - ref.value[0]) * m.rm_h - vel(1) * lag_s;
+        k = nav_filter::kPos;
+    } else if (ref.kind == PYINS_REF_GNSS_VEL) {
+        z[0] = vel(0) - ref.value[0];
+        z[1] = vel(1) - ref.value[1];
+    } else {
+        z[0] = vel(0);
+        z[1] = vel(1);
+    }
+    const double nis = nav_filter::nis_pair(nav_, k, z, r);
+    nav_nis_[slot] = nis;
+    if (!(nis <= cfg_.nav_gate)) {   // a NaN fails too
+        count(&n_ref_rejected_[slot], 1u);
+        if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
+            ref_reject_run_[slot] = ref_reject_run_[slot] + 1;
+        }
+        if (ref_reject_run_[slot] == cfg_.nav_reject_limit) {
+            ref_out_[slot] = 1;
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_REF_REJECTED);
+        }
+        return;
+    }
+    ref_reject_run_[slot] = 0;
+    ref_out_[slot] = 0;
+    count(&n_ref_used_[slot], 1u);
+    ref_used_tick_[slot] = tick_;
+    nav_filter::update_pair(nav_, k, z, r);
+    if (nav_.healthy == 0) {
+        faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
+    }
+    // Feedback (nav_filter.hpp): C_p^n = (I + phi x) C_p^n', v -= dv, p -= dp.
+    const double* x = nav_.x.data();
+    const Vec3 phi(x[nav_filter::kPhi], x[nav_filter::kPhi + 1], x[nav_filter::kPhi + 2]);
+    strapdown::NavState& nav = sd_.nav;
+    nav.quat_np = attitude::quat_normalize(attitude::quat_mul(attitude::rotvec_to_quat(phi), nav.quat_np));
+    nav.vel_n(0) = nav.vel_n(0) - x[nav_filter::kVel];
+    nav.vel_n(1) = nav.vel_n(1) - x[nav_filter::kVel + 1];
+    nav.lat = nav.lat - x[nav_filter::kPos + 1] / m.rm_h;
+    nav.lon = wrap_pi(nav.lon - x[nav_filter::kPos] / (m.rn_h * m.cos_lat));
+    nav_filter::reset_feedback(nav_);
+    nav_.c_start = attitude::quat_to_mat(nav.quat_np);
+}
+
+int32_t Firmware::nav_mode_now() const {
+    if (mode_ != Mode::kNavigate) {
+        return 0;
+    }
+    return nav_on_ != 0 && refs_in_use() != 0u ? static_cast<int32_t>(PYINS_NAV_INTEGRATED)
+                                                : static_cast<int32_t>(PYINS_NAV_UNDAMPED);
+}
+
+uint32_t Firmware::refs_in_use() const {
+    uint32_t bits = 0u;
+    const int64_t window = static_cast<int64_t>(kRefInUseS) * cfg_.tick_hz;
+    for (int32_t i = 0; i < kRefKinds; ++i) {
+        if (ref_used_tick_[i] >= 0 && tick_ - ref_used_tick_[i] <= window && ref_out_[i] == 0) {
+            bits = bits | (1u << i);
+        }
+    }
+    return bits;
+}
+
+}  // namespace pyins::firmware

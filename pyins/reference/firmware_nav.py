@@ -1,0 +1,188 @@
+"""The firmware at sea: the navigation filter beside the strapdown in
+NAVIGATE and the external references (``push_ref``).
+
+Mirrors ``csrc/src/firmware_nav.cpp`` (the Firmware members firmware.hpp
+declares under "Navigation at sea"), function by function: `NavAtSea` is
+mixed into `pyins.reference.firmware.Firmware` and works on its state.
+"""
+import math
+
+import numpy as np
+
+from . import abi, attitude, config, earth, nav_filter
+from .angle import wrap_pi
+
+REF_QUEUE = 8       #: kRefQueue
+REF_KINDS = 5       #: kRefKinds
+REF_IN_USE_S = 10   #: kRefInUseS
+U32 = 0xFFFFFFFF
+
+
+def count(counter, n=1):
+    """counter + n, saturating at 2^32 - 1 (mirrors count)."""
+    return U32 if n > U32 - counter else counter + n
+
+
+class NavAtSea:
+    """The navigation-at-sea members of the firmware (mixin)."""
+
+    def init_nav(self):
+        """The members firmware.cpp's init sets for this part."""
+        self.nav_on = 0
+        self.refq = []                 # the queue (the C++ ring, oldest first)
+        self.ref_last_tick = -1
+        self.nav = None
+        self.n_ref_used = [0] * REF_KINDS
+        self.n_ref_rejected = [0] * REF_KINDS
+        self.n_ref_skipped = [0] * REF_KINDS
+        self.ref_reject_run = [0] * REF_KINDS
+        self.ref_out = [0] * REF_KINDS
+        self.ref_used_tick = [-1] * REF_KINDS
+        self.nav_nis = [0.0] * REF_KINDS
+
+    def start_nav_filter(self):
+        cfg = self.cfg
+        kf_sigma = self._kf(lambda f: np.sqrt(np.diag(f.p)))
+        att = np.zeros(3)
+        for i in range(3):
+            configured = (cfg["fine_sigma0_att_rad"][i] if cfg["fine_sigma0_att_rad"][i] > 0.0
+                          else config.DEFAULT_FINE_SIGMA_ATT[i])
+            att[i] = kf_sigma[i] if self.kf_states != 0 else configured
+        prm = nav_filter.Params(
+            dt=self.dt, every=cfg["nav_every_ticks"], reject_limit=cfg["nav_reject_limit"],
+            gyro_arw=cfg["fine_gyro_arw"], accel_vrw=cfg["fine_accel_vrw"], gate=cfg["nav_gate"],
+            sigma0_att=att, sigma0_vel=config.NAV_SIGMA0_VEL, sigma0_pos=config.NAV_SIGMA0_POS,
+            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
+        self.nav = nav_filter.init(prm, attitude.quat_to_mat(self.sd.nav.quat_np))
+        self.nav_on = 1
+
+    def nav_motion(self):
+        nav = self.sd.nav
+        sin_lat, cos_lat = math.sin(nav.lat), math.cos(nav.lat)
+        rm, rn = earth.principal_radii(sin_lat)
+        return nav_filter.Motion(sin_lat, cos_lat, rm + nav.height, rn + nav.height,
+                                 float(nav.vel_n[0]), float(nav.vel_n[1]))
+
+    def nav_tick(self, dv_sf_n):
+        nav_filter.gather(self.nav, dv_sf_n)
+        if self.nav.ticks == self.nav.prm.every:
+            nav_filter.predict(self.nav, self.nav_motion(), attitude.quat_to_mat(self.sd.nav.quat_np))
+            if self.nav.healthy == 0:
+                self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
+
+    def push_ref(self, kind, tick, value, sigma):
+        """One reference; PYINS_OK or a PYINS_E_REF_* status (mirrors push_ref)."""
+        cfg = self.cfg
+        if cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED:
+            return abi.PYINS_E_REF_UNUSED
+        if kind not in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_ZERO_VEL):
+            return abi.PYINS_E_REF_KIND
+        value = [float(v) for v in value]
+        sigma = [float(s) for s in sigma]
+        if (not all(math.isfinite(v) for v in value) or not (sigma[0] > 0.0) or not (sigma[1] > 0.0)
+                or not math.isfinite(sigma[0]) or not math.isfinite(sigma[1])
+                or (kind == abi.PYINS_REF_GNSS_POS and not abs(value[0]) <= 0.5 * math.pi)):
+            return abi.PYINS_E_REF_VALUE
+        if tick < self.ref_last_tick or tick < self.tick - cfg["ref_max_latency_ticks"]:
+            return abi.PYINS_E_REF_ORDER
+        if tick > self.tick + config.REF_HORIZON_S * cfg["tick_hz"]:
+            return abi.PYINS_E_REF_FUTURE
+        ref = (int(kind), int(tick), value, sigma)
+        if tick > self.tick:
+            if len(self.refq) == REF_QUEUE:
+                return abi.PYINS_E_REF_FULL
+            self.refq.append(ref)
+            self.ref_last_tick = tick
+            return abi.PYINS_OK
+        self.ref_last_tick = tick
+        if self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on:
+            self.apply_ref(ref, self.tick - tick)
+        else:
+            self.n_ref_skipped[kind - 1] = count(self.n_ref_skipped[kind - 1])
+        return abi.PYINS_OK
+
+    def refs_due(self):
+        while self.refq and self.refq[0][1] <= self.tick:
+            ref = self.refq.pop(0)
+            if self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on:
+                self.apply_ref(ref, self.tick - ref[1])
+            else:
+                self.n_ref_skipped[ref[0] - 1] = count(self.n_ref_skipped[ref[0] - 1])
+
+    def apply_ref(self, ref, lag):
+        kind, _, value, sigma = ref
+        slot = kind - 1
+        m = self.nav_motion()
+        nav_filter.predict(self.nav, m, attitude.quat_to_mat(self.sd.nav.quat_np))
+        nav = self.sd.nav
+        lat, lon, vel = nav.lat, nav.lon, nav.vel_n.copy()
+        if self.has_lever:
+            lat, lon, _, vel = self.reference_point()
+        r = (sigma[0] * sigma[0], sigma[1] * sigma[1])
+        k = nav_filter.VEL
+        if kind == abi.PYINS_REF_GNSS_POS:
+            lag_s = float(lag) * self.dt
+            z = (wrap_pi(lon - value[1]) * m.rn_h * m.cos_lat - vel[0] * lag_s,
+                 (lat - value[0]) * m.rm_h - vel[1] * lag_s)
+            k = nav_filter.POS
+        elif kind == abi.PYINS_REF_GNSS_VEL:
+            z = (vel[0] - value[0], vel[1] - value[1])
+        else:
+            z = (vel[0], vel[1])
+        nis = nav_filter.nis_pair(self.nav, k, z, r)
+        self.nav_nis[slot] = nis
+        if not nis <= self.cfg["nav_gate"]:
+            self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
+            if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
+                self.ref_reject_run[slot] += 1
+            if self.ref_reject_run[slot] == self.cfg["nav_reject_limit"]:
+                self.ref_out[slot] = 1
+                self.faults = self.faults | abi.PYINS_FAULT_REF_REJECTED
+            return
+        self.ref_reject_run[slot] = 0
+        self.ref_out[slot] = 0
+        self.n_ref_used[slot] = count(self.n_ref_used[slot])
+        self.ref_used_tick[slot] = self.tick
+        nav_filter.update_pair(self.nav, k, z, r)
+        if self.nav.healthy == 0:
+            self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
+        x = self.nav.x
+        phi = x[nav_filter.PHI:nav_filter.PHI + 3]
+        nav.quat_np = attitude.quat_normalize(attitude.quat_mul(attitude.rotvec_to_quat(phi), nav.quat_np))
+        nav.vel_n[0] = nav.vel_n[0] - x[nav_filter.VEL]
+        nav.vel_n[1] = nav.vel_n[1] - x[nav_filter.VEL + 1]
+        nav.lat = nav.lat - x[nav_filter.POS + 1] / m.rm_h
+        nav.lon = wrap_pi(nav.lon - x[nav_filter.POS] / (m.rn_h * m.cos_lat))
+        nav_filter.reset_feedback(self.nav)
+        self.nav.c_start = attitude.quat_to_mat(nav.quat_np)
+
+    def nav_mode_now(self):
+        if self.mode != abi.PYINS_MODE_NAVIGATE:
+            return 0
+        return abi.PYINS_NAV_INTEGRATED if self.nav_on and self.refs_in_use() else abi.PYINS_NAV_UNDAMPED
+
+    def refs_in_use(self):
+        window = REF_IN_USE_S * self.cfg["tick_hz"]
+        bits = 0
+        for i in range(REF_KINDS):
+            if self.ref_used_tick[i] >= 0 and self.tick - self.ref_used_tick[i] <= window and not self.ref_out[i]:
+                bits = bits | (1 << i)
+        return bits
+
+    def nav_output(self):
+        """The record's navigation-at-sea fields (mirrors the end of output())."""
+        on = self.nav_on != 0
+        p = self.nav.p if on else None
+        return {
+            "nav_mode": self.nav_mode_now(),
+            "ref_in_use": self.refs_in_use() if self.mode == abi.PYINS_MODE_NAVIGATE else 0,
+            "n_ref_used": np.array(self.n_ref_used),
+            "n_ref_rejected": np.array(self.n_ref_rejected),
+            "n_ref_skipped": np.array(self.n_ref_skipped),
+            "nav_nis": np.array(self.nav_nis),
+            "nav_sigma_pos_m": math.sqrt(p[nav_filter.POS, nav_filter.POS]
+                                         + p[nav_filter.POS + 1, nav_filter.POS + 1]) if on else 0.0,
+            "nav_sigma_heading_rad": math.sqrt(p[nav_filter.PHI + 2, nav_filter.PHI + 2]) if on else 0.0,
+            "nav_gyro_bias_rad_s": self.nav.gyro_bias.copy() if on else np.zeros(3),
+            "nav_accel_bias_mps2": self.nav.accel_bias.copy() if on else np.zeros(3),
+        }
