@@ -10,6 +10,9 @@ errors, files. One room per concept:
   sway (`LinearMotion`), lever arms (`ShipAtSea`), wave spectra
   (`sea_spectrum_motion`, `SEA_STATE_SPECTRA`) and the built-in moored ship
   (`moored`, `MOORED_SHIP`).
+- `pyins.sim.voyage`: a ship under way at sea (`Voyage`: a `Manoeuvre`
+  track with the heel of its turns, the sea-state swing and heave;
+  `default_voyage`, a multi-hour transit).
 - `pyins.sim.turntable`: the table's profiles (`TableMotion`, `Fixed`,
   `ConstantRate`) and the NumPy mirror of the compiled firmware-in-the-loop
   plant (csrc/plant/plant.cpp).
@@ -39,6 +42,7 @@ from pyins.sim.ship import (MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAt
                             heave_response, jonswap, moored, named_sea_spectrum,
                             pierson_moskowitz, sea_spectrum_motion)
 from pyins.sim.turntable import ConstantRate, Fixed, TableMotion
+from pyins.sim.voyage import Voyage, default_voyage
 
 __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
@@ -47,6 +51,7 @@ __all__ = [
     "SEA_STATES", "HeadingSwing", "Manoeuvre", "Motion", "MotionState", "Segment", "Static",
     "Swing", "default_segments", "sea_state",
     "PRESETS", "SensorErrors", "SensorModel", "preset",
+    "Voyage", "default_voyage",
     "MOORED_SHIP", "SEA_STATE_SPECTRA", "LinearMotion", "ShipAtSea", "dnv_gamma", "heave_response",
     "jonswap", "moored", "named_sea_spectrum", "pierson_moskowitz", "sea_spectrum_motion",
     "ConstantRate", "Fixed", "TableMotion",
