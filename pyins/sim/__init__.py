@@ -13,6 +13,10 @@ errors, files. One room per concept:
 - `pyins.sim.voyage`: a ship under way at sea (`Voyage`: a `Manoeuvre`
   track with the heel of its turns, the sea-state swing and heave;
   `default_voyage`, a multi-hour transit).
+- `pyins.sim.references`: the external reference sensors (GNSS with its
+  bias, outages, outliers, frozen and offset receivers; EM speed log; DVL;
+  zero velocity; the water current) as the firmware's pyins_ref records,
+  and their CSV files on the IMU's clock.
 - `pyins.sim.turntable`: the table's profiles (`TableMotion`, `Fixed`,
   `ConstantRate`) and the NumPy mirror of the compiled firmware-in-the-loop
   plant (csrc/plant/plant.cpp).
