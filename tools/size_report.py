@@ -54,6 +54,8 @@ MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "nav_null"
 API_OF = {"nav_null": ("nav", "null", "pyins_run"), "nav_compact": ("nav", "compact", "pyins_run_nav")}
 TARGETS = (("cortex-m7", "build-m7", "mps2-an500"), ("cortex-m4f", "build-m4", "mps2-an386"))
 TICK_HZ = 100
+#: The M7 core's text budget [bytes] (docs/embedded.md, "Code size": why 80 KiB).
+M7_TEXT_BUDGET = 80 * 1024
 
 
 def size_of(path):
@@ -152,7 +154,8 @@ def main(argv=None):
             print(f"    PROBLEM: {p}")
     m7 = fig.get("cortex-m7_core_text_bytes")
     if m7 is not None:
-        print(f"budgets on the M7: core text {m7:,d} <= 65,536 -> {'met' if m7 <= 65536 else 'NOT met'}; "
+        print(f"budgets on the M7: core text {m7:,d} <= {M7_TEXT_BUDGET:,d} -> "
+              f"{'met' if m7 <= M7_TEXT_BUDGET else 'NOT met'}; "
               f"instance {fig['instance_bytes_host']:,d} <= 16,384 -> "
               f"{'met' if fig['instance_bytes_host'] <= 16384 else 'NOT met'}")
 

@@ -29,9 +29,12 @@ void Firmware::start_nav_filter() {
     double kf_x[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     double kf_sigma[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     fine_.record(kf_x, kf_sigma);
+    // (the defaults copied: the inline table's address is not taken, which
+    // on the target would reach it through the global offset table)
+    const double defaults[3] = {config::kDefaultFineSigmaAtt[0], config::kDefaultFineSigmaAtt[1],
+                                config::kDefaultFineSigmaAtt[2]};
     for (int i = 0; i < 3; ++i) {
-        const double configured = cfg_.fine_sigma0_att_rad[i] > 0.0 ? cfg_.fine_sigma0_att_rad[i]
-                                                                    : config::kDefaultFineSigmaAtt[i];
+        const double configured = cfg_.fine_sigma0_att_rad[i] > 0.0 ? cfg_.fine_sigma0_att_rad[i] : defaults[i];
         prm.sigma0_att[i] = fine_.states() != 0 ? kf_sigma[i] : configured;
     }
     prm.sigma0_vel = config::kNavSigma0Vel;
