@@ -411,7 +411,10 @@ typedef struct pyins_output {
     uint32_t n_ref_used[5];       /* references applied (passed their gate) */
     uint32_t n_ref_rejected[5];   /* references that failed the innovation gate */
     uint32_t n_ref_skipped[5];    /* references whose tick passed before navigation (alignment) */
-    int32_t reserved2;
+    uint32_t n_ref_stale[5];      /* references not used because they repeat the last one of their kind
+                                     bit for bit (a frozen receiver: no new information); those while the
+                                     ship moved more than 3 sigma since the first copy (position: at the
+                                     speed now; velocity: its change) count as rejected too */
     double nav_nis[5];            /* the latest normalised innovation squared per kind (gated or not) */
     double nav_sigma_pos_m;       /* the filter's horizontal position sigma sqrt(P_EE + P_NN) [m]
                                      (0 without the filter) */
@@ -436,7 +439,7 @@ typedef struct pyins_motor_command {
  * the same names, bit for bit, without the Euler angles, the heading, the
  * alignment filter's state and the counters, whose derivation costs as much
  * as the navigation tick (pyins_run_nav, pyins_get_nav). 168 bytes against
- * pyins_output's 624. */
+ * pyins_output's 640. */
 typedef struct pyins_nav {
     int64_t tick;                 /* = pyins_output.tick */
     int32_t mode;                 /* = pyins_output.mode (enum pyins_mode) */

@@ -81,6 +81,13 @@ void Firmware::init(const pyins_config& raw) {
         ref_out_[i] = 0;
         ref_used_tick_[i] = -1;
         nav_nis_[i] = 0.0;
+        n_ref_stale_[i] = 0u;
+        ref_seen_[i] = 0;
+        ref_seen_tick_[i] = -1;
+        ref_seen_value_[i][0] = 0.0;
+        ref_seen_value_[i][1] = 0.0;
+        ref_seen_vel_[i][0] = 0.0;
+        ref_seen_vel_[i][1] = 0.0;
     }
     reserved_ref_ = 0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
@@ -881,9 +888,9 @@ void Firmware::output(pyins_output* out) const {
         out->n_ref_used[i] = n_ref_used_[i];
         out->n_ref_rejected[i] = n_ref_rejected_[i];
         out->n_ref_skipped[i] = n_ref_skipped_[i];
+        out->n_ref_stale[i] = n_ref_stale_[i];
         out->nav_nis[i] = nav_nis_[i];
     }
-    out->reserved2 = 0;
     const bool filter = nav_on_ != 0;
     out->nav_sigma_pos_m = filter ? pmath::sqrt(nav_.p(nav_filter::kPos, nav_filter::kPos) +
                                                 nav_.p(nav_filter::kPos + 1, nav_filter::kPos + 1))

@@ -265,6 +265,12 @@ class Firmware {
     int32_t reserved_ref_;                ///< (keeps the layout free of padding)
     int64_t ref_used_tick_[kRefKinds];    ///< tick of the last applied (-1: none)
     double nav_nis_[kRefKinds];
+    // The frozen-receiver test (apply_ref): the last reference of each kind.
+    uint32_t n_ref_stale_[kRefKinds];
+    int32_t ref_seen_[kRefKinds];         ///< 1: a reference of the kind has been seen
+    int64_t ref_seen_tick_[kRefKinds];    ///< its tick
+    double ref_seen_value_[kRefKinds][2]; ///< its value[0], value[1]
+    double ref_seen_vel_[kRefKinds][2];   ///< the reference point's velocity then (E, N) [m/s]
 };
 
 }  // namespace pyins::firmware

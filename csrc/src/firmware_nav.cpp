@@ -151,7 +151,46 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     }
     const double nis = nav_filter::nis_pair(nav_, k, z, r);
     nav_nis_[slot] = nis;
-    if (!(nis <= cfg_.nav_gate)) {   // a NaN fails too
+    // A frozen receiver repeats its last fix bit for bit: a repeat carries no
+    // new information and is not used (applied, a frozen velocity would pull
+    // the INS with it and a correlated error would pass as white noise). A
+    // real receiver moving does not repeat (its noise moves the digits); at
+    // rest, or cruising with a quantised NMEA speed, it may: a repeat counts
+    // as rejected only when the ship moved more than 3 sigma since the first
+    // copy (position: the distance at the speed now; velocity: the change of
+    // the velocity). Zero velocity is the same value by design.
+    bool stale = false;
+    const bool repeat = ref.kind != PYINS_REF_ZERO_VEL && ref_seen_[slot] != 0 &&
+                        ref.value[0] == ref_seen_value_[slot][0] && ref.value[1] == ref_seen_value_[slot][1];
+    if (repeat) {
+        const double sigma = ref.sigma[0] > ref.sigma[1] ? ref.sigma[0] : ref.sigma[1];
+        double moved;
+        if (ref.kind == PYINS_REF_GNSS_POS) {
+            const double span = static_cast<double>(ref.tick - ref_seen_tick_[slot]) * dt_;
+            moved = pmath::sqrt(vel(0) * vel(0) + vel(1) * vel(1)) * span;
+        } else {
+            const double de = vel(0) - ref_seen_vel_[slot][0];
+            const double dn = vel(1) - ref_seen_vel_[slot][1];
+            moved = pmath::sqrt(de * de + dn * dn);
+        }
+        stale = moved > 3.0 * sigma;
+    }
+    if (!repeat) {
+        // (a repeat keeps the first copy's tick and velocity: the freeze's start)
+        ref_seen_[slot] = 1;
+        ref_seen_tick_[slot] = ref.tick;
+        ref_seen_value_[slot][0] = ref.value[0];
+        ref_seen_value_[slot][1] = ref.value[1];
+        ref_seen_vel_[slot][0] = vel(0);
+        ref_seen_vel_[slot][1] = vel(1);
+    }
+    if (repeat) {
+        count(&n_ref_stale_[slot], 1u);
+        if (!stale) {
+            return;
+        }
+    }
+    if (stale || !(nis <= cfg_.nav_gate)) {   // a NaN fails too
         count(&n_ref_rejected_[slot], 1u);
         if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
             ref_reject_run_[slot] = ref_reject_run_[slot] + 1;

@@ -39,6 +39,11 @@ class NavAtSea:
         self.ref_out = [0] * REF_KINDS
         self.ref_used_tick = [-1] * REF_KINDS
         self.nav_nis = [0.0] * REF_KINDS
+        self.n_ref_stale = [0] * REF_KINDS
+        self.ref_seen = [0] * REF_KINDS
+        self.ref_seen_tick = [-1] * REF_KINDS
+        self.ref_seen_value = [(0.0, 0.0)] * REF_KINDS
+        self.ref_seen_vel = [(0.0, 0.0)] * REF_KINDS
 
     def start_nav_filter(self):
         cfg = self.cfg
@@ -131,7 +136,31 @@ class NavAtSea:
             z = (vel[0], vel[1])
         nis = nav_filter.nis_pair(self.nav, k, z, r)
         self.nav_nis[slot] = nis
-        if not nis <= self.cfg["nav_gate"]:
+        # a frozen receiver: the last value repeated while the ship moved (mirrors apply_ref)
+        stale = False
+        repeat = bool(kind != abi.PYINS_REF_ZERO_VEL and self.ref_seen[slot]
+                      and value[0] == self.ref_seen_value[slot][0]
+                      and value[1] == self.ref_seen_value[slot][1])
+        if repeat:
+            sigma_max = sigma[0] if sigma[0] > sigma[1] else sigma[1]
+            if kind == abi.PYINS_REF_GNSS_POS:
+                span = float(ref[1] - self.ref_seen_tick[slot]) * self.dt
+                moved = math.sqrt(vel[0] * vel[0] + vel[1] * vel[1]) * span
+            else:
+                de = vel[0] - self.ref_seen_vel[slot][0]
+                dn = vel[1] - self.ref_seen_vel[slot][1]
+                moved = math.sqrt(de * de + dn * dn)
+            stale = moved > 3.0 * sigma_max
+        if not repeat:
+            self.ref_seen[slot] = 1
+            self.ref_seen_tick[slot] = ref[1]
+            self.ref_seen_value[slot] = (value[0], value[1])
+            self.ref_seen_vel[slot] = (float(vel[0]), float(vel[1]))
+        if repeat:
+            self.n_ref_stale[slot] = count(self.n_ref_stale[slot])
+            if not stale:
+                return
+        if stale or not nis <= self.cfg["nav_gate"]:
             self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
             if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
                 self.ref_reject_run[slot] += 1
@@ -179,6 +208,7 @@ class NavAtSea:
             "n_ref_used": np.array(self.n_ref_used),
             "n_ref_rejected": np.array(self.n_ref_rejected),
             "n_ref_skipped": np.array(self.n_ref_skipped),
+            "n_ref_stale": np.array(self.n_ref_stale),
             "nav_nis": np.array(self.nav_nis),
             "nav_sigma_pos_m": math.sqrt(p[nav_filter.POS, nav_filter.POS]
                                          + p[nav_filter.POS + 1, nav_filter.POS + 1]) if on else 0.0,

@@ -21,7 +21,9 @@ def _static(n):
     return contract.make_samples(np.zeros((n, 3)), np.tile([0.0, 0.0, G * 0.01], (n, 1)))
 
 
-def _pos(tick, lat=LAT, lon=0.0, sigma=3.0):
+def _pos(tick, lat=LAT, lon=None, sigma=3.0):
+    # a distinct longitude per tick (a repeated fix is a frozen receiver's: not used)
+    lon = tick * 1e-12 if lon is None else lon
     return contract.make_refs("gnss_pos", [tick], [[lat, lon, 0.0]], [[sigma, sigma, 5.0]])
 
 
