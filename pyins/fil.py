@@ -13,15 +13,24 @@ decimated records (every ``every`` ticks) come back, so memory stays bounded
 for any duration; with a record directory they stream to disk
 (`pyins.records`) and the run checkpoints and resumes.
 
+External references (GNSS position and velocity, zero velocity) reach the
+firmware through ``push_ref`` between plant calls: a chunk is split at the
+ticks where the next reference must be pushed (`pyins.aiding.Aider`, the
+open loop's rule: at its availability tick, or up to 5 s ahead of its tick,
+at most 8 waiting in the firmware's queue), one plant call per refill of
+the queue.
+
 `run_fil` is a guarded prefix (what cannot run is refused before anything
 starts), then named steps:
 
 1. the loop's parts: the initial state, the firmware, the plant, the noise;
 2. the record directory: a fresh one, or the state of its last checkpoint;
-3. chunk by chunk: the ship's rates, the noise, the closed loop, the records;
+3. chunk by chunk: the ship's rates, the noise, the closed loop (split where
+   references are pushed), the records;
 4. a checkpoint when one is due;
 5. the result, the records beside the truth.
 """
+import hashlib
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -30,6 +39,7 @@ import numpy as np
 
 from pyins import engine as engines
 from pyins import contract, records, sim
+from pyins.aiding import Aider
 from pyins.records import CHECKPOINT, PLANT_RECORD_DTYPE, FilResult, load_records
 from pyins.scenario.build import initial_config
 from pyins.sim.turntable import TableConfig, error_matrices
@@ -90,9 +100,70 @@ class _Loop:
         return g, a, self.rng.bit_generator.state
 
 
+class _Stopped(Exception):
+    """A chunk cut short by a rejected sample or reference: the records
+    before it and the error to raise."""
+
+    def __init__(self, exc, outputs, records):
+        super().__init__(str(exc))
+        self.exc, self.outputs, self.records = exc, outputs, records
+
+
+def _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0, g_noise, a_noise, n, every):
+    """The next ``n`` ticks of the closed loop: (outputs, plant records).
+    Without references one plant call; with them the chunk is split at the
+    ticks the Aider names (`Aider.next_stop`), the references due pushed
+    between the calls and at the chunk's end (so a checkpoint after it holds
+    them in the firmware's queue, as `Aider.seek` assumes)."""
+    if aider is None:
+        try:
+            return loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise, n,
+                                  loop.dt, every)
+        except contract.PlantError as exc:
+            raise _Stopped(exc, exc.outputs, exc.records) from None
+    now0 = tick0 + loop.done
+    outs, recs, i = [], [], 0
+    try:
+        while True:
+            aider.push_due(loop.fw, now0 + i)
+            if i >= n:
+                break
+            nxt = aider.next_stop(now0 + i)
+            stop = n if nxt is None else min(n, nxt - now0)
+            if loop.period is None:         # this chunk's rates: the part's own
+                part = (omega[i:stop], force[i:stop], x, w, stop - i, 0)
+            else:                           # one period tiled: the part's phase in it
+                part = (omega, force, x, w, period, (phase0 + i) % period)
+            out, rec = loop.plant.run(loop.fw, *part,
+                                      None if g_noise is None else g_noise[i:stop],
+                                      None if a_noise is None else a_noise[i:stop],
+                                      stop - i, loop.dt, every)
+            outs.append(out)
+            recs.append(rec)
+            i = stop
+    except contract.PlantError as exc:      # the chunk's: its records and ticks before the sample
+        outs.append(exc.outputs)
+        recs.append(exc.records)
+        out, rec = _joined(outs, recs)
+        where = str(exc)[:-len(contract.status_str(exc.code)) - 2]     # "pyins_fil_run at tick T"
+        raise _Stopped(contract.PlantError(exc.code, where, i + exc.n_done, out, rec), out, rec) from None
+    except contract.RefError as exc:
+        raise _Stopped(exc, *_joined(outs, recs)) from None
+    return _joined(outs, recs)
+
+
+def _joined(outs, recs):
+    """The parts of a chunk as one array each (a single part as it is)."""
+    if len(outs) == 1:
+        return outs[0], recs[0]
+    if not outs:
+        return np.zeros(0, dtype=contract.OUTPUT_DTYPE), np.zeros(0, dtype=PLANT_RECORD_DTYPE)
+    return np.concatenate(outs), np.concatenate(recs)
+
+
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
             chunk_ticks=500_000, dt=DT, nodes=5, progress=None, record_dir=None,
-            checkpoint_ticks=None, resume=False, engine="native"):
+            checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -108,6 +179,15 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     by chunk and returned memory-mapped, so memory stays bounded for any
     duration. Returns a FilResult.
 
+    ``refs`` (REF_DTYPE, sorted by tick; e.g. ``pyins.sim.references.gnss(...)
+    .refs``) are external references pushed as they become available, as
+    `pyins.open_loop.navigate` pushes them (`pyins.aiding.Aider`):
+    ``avail_tick`` (one per reference, >= its tick) the tick at which each
+    reaches the firmware, None to push each up to 5 s ahead of its tick (the
+    firmware applies it at exactly its tick). A reference the firmware
+    refuses raises contract.RefError with its index in ``refs`` (the records
+    before it are kept, as at a rejected sample).
+
     Checkpoints (need ``record_dir``): every ``checkpoint_ticks`` (rounded up
     to whole chunks) the firmware snapshot, the plant state, the noise
     generator's state and the number of records written go to
@@ -115,8 +195,11 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     flushed to disk). With ``resume=True`` a run killed at any moment
     continues from its last checkpoint: the records written after it are cut
     off and recomputed, and the result is bit-identical to an uninterrupted
-    run. A checkpoint of a different run (other motion, errors, seed,
-    configuration, chunking) is refused with ValueError. The plant state is
+    run (with references too: which ones were pushed by a tick is a function
+    of the tick, `Aider.seek`, and the firmware's snapshot holds its queue).
+    A checkpoint of a different run (other motion, errors, seed,
+    configuration, chunking, references or their availability) is refused
+    with ValueError. The plant state is
     stored as raw bytes: resume on the machine kind that wrote it.
     """
     # the guarded prefix
@@ -133,6 +216,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     table = table if table is not None else TableConfig()
     cfg = initial_config(motion, None, **(config or {}))
     loop = _Loop(motion, cfg, errors, seed, table, dt, nodes, engine)
+    aider = Aider(refs, avail_tick, tick_hz=int(round(1.0 / dt))) if refs is not None else None
+    tick0 = int(loop.fw.nav()["tick"])      # the firmware's tick at loop.done == 0
 
     # 2. the record directory, fresh or from its last checkpoint
     sink = None
@@ -143,6 +228,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         os.makedirs(record_dir, exist_ok=True)
         digest = records.run_digest(motion, duration_ticks, cfg, errors, seed, table, every,
                                     chunk_ticks, dt, nodes, engine)
+        if aider is not None and len(aider.refs):     # no references: the digest of the runs before them
+            digest = hashlib.sha256(f"{digest}+refs:{aider.identity()}".encode()).hexdigest()
         ck_path = os.path.join(record_dir, CHECKPOINT)
         n_records, mode = 0, "wb"
         if resume and os.path.exists(ck_path):
@@ -151,6 +238,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             loop.plant.restore(ck["plant"])
             loop.rng.bit_generator.state = ck["rng"]
             loop.done, n_records = ck["done_ticks"], ck["n_records"]
+            if aider is not None:
+                aider.seek(tick0, tick0 + loop.done)
             mode = "r+b"
         sink = records.RecordSink(record_dir, n_records, mode)
         if mode == "wb" and os.path.exists(ck_path):
@@ -172,13 +261,13 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             n_next = min(chunk_ticks, duration_ticks - loop.done - n)
             pending = ahead.submit(loop.noise, n_next) if n_next > 0 else None
             try:
-                out, rec = loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise,
-                                          n, dt, every)
-            except contract.PlantError as exc:         # keep what was done before the rejected sample
+                out, rec = _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0,
+                                        g_noise, a_noise, n, every)
+            except _Stopped as stop:       # keep what was done before the rejected sample or reference
                 if sink is not None:
-                    sink.write(exc.outputs, exc.records)
+                    sink.write(stop.outputs, stop.records)
                     sink.close()
-                raise
+                raise stop.exc from None
             if sink is not None:
                 sink.write(out, rec)
             else:
