@@ -31,6 +31,7 @@ import numpy as np
 from pyins import engine as engines
 from pyins import contract, logs, metrics, open_loop, records, scenario, sim
 from pyins.reference import abi
+from pyins.reference.config import DEFAULT_NAV_GATE
 from pyins.reference.fine_align import PHI
 from pyins.reference.firmware import VALID_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
@@ -285,7 +286,7 @@ def claim_dir(out_dir, keep=None):
 
 
 def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_path=None, reference=None,
-           block=BLOCK, progress=None, t_first=None, notes=None):
+           block=BLOCK, progress=None, t_first=None, notes=None, feed=None):
     """Run a recorded IMU log through the firmware configured by ``cfg`` into
     ``out_dir`` and return the summary dict (also summary.json). ``data``: a
     pyins.sim.io.ImuData, or an iterable of them in order (the blocks of a
@@ -299,6 +300,10 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
     then its tick x dt). ``progress(samples_done)`` after each block.
     ``notes()``: the warnings of the log itself (its gaps, their bridge),
     asked for when the blocks are out and kept first in the summary's.
+    ``feed``: a `pyins.aiding.BlockFeed` of external references (a file's,
+    zero velocity at rest), pushed block by block at their ticks; what was
+    used, rejected and not covered goes to the summary's ``references`` and
+    its warnings.
     ``out_dir`` is the replay's (`claim_dir`: an earlier replay there is
     replaced, anything else refused).
 
@@ -328,7 +333,7 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
         try:
             for piece in _blocks(data, block):
                 chunk = contract.make_samples(piece.dtheta_p, piece.dv_p, piece.table_angle_rad)
-                recs = fw.run(chunk, every=every)
+                recs = fw.run(chunk, every=every) if feed is None else feed.run(fw, chunk, every)
                 samples += len(chunk)
                 if len(recs):
                     # the records and what the summary counts of them go
@@ -353,6 +358,13 @@ def replay(data, cfg, out_dir, every=TICK_HZ, spec=None, engine="native", log_pa
                                  f"longer log)")
             summary = acc.summary(log_path, samples, every)
             summary["warnings"][:0] = list(notes() if notes is not None else ())
+            if feed is not None:
+                last = acc.last[0]
+                nav_from = (cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
+                            if last["mode"] == abi.PYINS_MODE_NAVIGATE else None)
+                summary["references"], said = feed.summary(last, nav_from)
+                summary["references"]["gate"] = float(cfg.get("nav_gate") or DEFAULT_NAV_GATE)
+                summary["warnings"].extend(said)
             if interrupted:
                 t = float(acc.last["tick"][0] / hz)
                 summary.update(complete=False, state="interrupted")

@@ -10,7 +10,8 @@ import zipfile
 
 import numpy as np
 
-from pyins import engine, logs, replay, replay_options, report, scenario, truth_track
+from pyins import aiding, engine, logs, replay, replay_options, report, scenario, truth_track
+from pyins.sim import references as reference_files
 from pyins.reference import abi
 from pyins.report import replay as report_replay
 
@@ -75,6 +76,13 @@ def add_replay(cmd):
                    help="errors against a reference trajectory: a text file with a header line naming "
                         "t, lat_deg, lon_deg [, height_m, heading_deg], t on the log's clock "
                         "(docs/cli.md, \"pyins replay\")")
+    p.add_argument("--refs", metavar="FILE",
+                   help="external references used in navigation (GNSS position and velocity, zero "
+                        "velocity), ticks on the log's clock (tick 0 its first sample): the text layout "
+                        "'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, \"Reference files\")")
+    p.add_argument("--zero-velocity", nargs="?", const="0.01 m/s", metavar="SIGMA",
+                   help="the vehicle or ship at rest after its alignment: a zero-velocity reference every "
+                        "second of navigation, SIGMA per axis (default '0.01 m/s')")
     p.add_argument("--out", help="output directory (default runs/replay)")
     p.add_argument("--engine", choices=engine.ENGINES, default="native",
                    help="the firmware: native (compiled, default) or reference (NumPy mirror)")
@@ -193,6 +201,39 @@ def cmd_replay(args):
             os.remove(spooled)
 
 
+def _feed(args, cfg, hz):
+    """The external references of --refs and --zero-velocity (a
+    `pyins.aiding.BlockFeed`), or None; refused before the log runs when
+    they cannot be used."""
+    if args.refs is None and args.zero_velocity is None:
+        return None
+    if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
+        raise InputError("--refs/--zero-velocity: the scenario sets firmware.nav_mode = \"undamped\", "
+                         "which takes no references")
+    refs = zv = None
+    if args.refs is not None:
+        try:
+            refs = reference_files.load_refs_csv(args.refs)
+        except OSError as exc:
+            raise InputError(f"--refs {args.refs}: {exc.strerror or exc}") from None
+        except UnicodeDecodeError:
+            raise InputError(f"--refs {args.refs}: not a text file of references (bytes that are not "
+                             "ASCII); the layout is in docs/log-formats.md, \"Reference files\"") from None
+        if not len(refs):
+            raise InputError(f"--refs {args.refs}: holds no reference (only its header)")
+        unused = sorted({reference_files.KIND_NAMES[int(k)] for k in refs["kind"]}
+                        - {"gnss_pos", "gnss_vel", "zero_velocity"})
+        if unused:
+            raise InputError(f"--refs {args.refs}: {', '.join(unused)} references are not used by this "
+                             "firmware yet (it takes gnss_pos, gnss_vel and zero_velocity)")
+    if args.zero_velocity is not None:
+        zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
+        if not (np.isfinite(zv) and zv > 0.0):
+            raise InputError(f"--zero-velocity {args.zero_velocity!r}: a sigma must be more than 0 m/s")
+    zv_from = cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
+    return aiding.BlockFeed(refs, zv, zv_from, hz)
+
+
 def _replay(args, path, fmt):
     dt = args.dt
     if args.time_col == "none" and dt is None and args.rate is not None:
@@ -228,6 +269,8 @@ def _replay(args, path, fmt):
     # 2. what the firmware cannot be right without, refused before it runs
     cfg, hz = replay_options.config(args, data, spec, cfg, say=lambda text: say(args, text))
 
+    feed = _feed(args, cfg, hz)
+
     # 3. the log through the firmware
     out_dir = args.out or default_out("replay")
     every = args.every if args.every is not None else hz
@@ -246,7 +289,7 @@ def _replay(args, path, fmt):
     try:
         summary = replay.replay(blocks, cfg, out_dir, every=every, spec=truth_of, engine=args.engine,
                                 log_path=args.log, reference=reference,
-                                t_first=data.metadata.get("t_first"), notes=notes,
+                                t_first=data.metadata.get("t_first"), notes=notes, feed=feed,
                                 progress=None if bar is None else (lambda done: bar(min(done, data.n), data.n)))
     except KeyboardInterrupt:
         if os.path.exists(os.path.join(out_dir, "summary.json")):
@@ -273,6 +316,10 @@ def _replay(args, path, fmt):
     mode = report_replay.MODES.get(fin["mode"], f"mode {fin['mode']}")
     say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, {mode}, "
                f"faults {', '.join(faults) or 'none'}")
+    for name, k in summary.get("references", {}).get("kinds", {}).items():
+        say(args, f"  references {name}: {k['given']} given, {k['used']} used, {k['rejected']} rejected by "
+                   f"the gate" + (f", {k['stale']} repeats unused" if k["stale"] else "")
+                   + (f", {k['skipped']} before navigation" if k["skipped"] else ""))
     for w in summary.get("warnings", ()):
         print(f"  WARNING: {w}", file=sys.stderr, flush=True)
     if "errors" in summary:

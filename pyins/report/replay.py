@@ -12,7 +12,12 @@ report DIR`` re-renders it. What a user replaying a field log needs to see:
    apart;
 4. report.html: the aligned attitude, the sigmas and drift estimates at the
    end of the fine alignment, the integrity figures and fault bits, the
-   warnings, the final state.
+   warnings, the final state;
+5. with external references (``--refs``, ``--zero-velocity``):
+   references.png, the navigation mode and the references in use over
+   time, each kind's normalised innovation against its gate, and the
+   filter's position and heading sigmas; a row per kind on the page (given,
+   used, rejected, repeats, before navigation).
 """
 import html
 import json
@@ -20,8 +25,9 @@ import os
 
 import numpy as np
 
-from pyins import logs
+from pyins import contract, logs
 from pyins.reference import abi
+from pyins.reference.config import DEFAULT_NAV_GATE
 from pyins.reference.fine_align import EPS, EPS_NU, PHI
 from pyins.report.plotting import MAX_POINTS, envelope, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
@@ -171,6 +177,69 @@ def _kept(rows, budget):
     return rows[np.unique(np.concatenate(idx))]
 
 
+#: the fields references.png draws
+_NAV_FIELDS = ("tick", "mode", "nav_mode", "ref_in_use", "nav_nis", "nav_sigma_pos_m", "nav_sigma_heading_rad")
+
+
+def _nav_kept(rows, budget):
+    """Of a block's navigation records, those that hold the envelope of each
+    kind's NIS and of the sigmas, and every change of mode or references in
+    use, in the fields references.png draws."""
+    rows = rows[rows["mode"] == abi.PYINS_MODE_NAVIGATE]
+    if not len(rows):
+        return np.zeros(0, dtype=[(f, rows.dtype[f]) for f in _NAV_FIELDS])
+    i = np.arange(len(rows))
+    curves = [rows["nav_nis"][:, k] for k in range(rows["nav_nis"].shape[1])]
+    curves += [rows["nav_sigma_pos_m"], rows["nav_sigma_heading_rad"]]
+    idx = [envelope(i, c, budget)[0] for c in curves]
+    change = np.flatnonzero((np.diff(rows["nav_mode"]) != 0) | (np.diff(rows["ref_in_use"]) != 0))
+    idx += [change, change + 1, [0, len(rows) - 1]]
+    keep = rows[np.unique(np.concatenate(idx).astype(np.int64))]
+    out = np.zeros(len(keep), dtype=[(f, rows.dtype[f]) for f in _NAV_FIELDS])
+    for f in _NAV_FIELDS:
+        out[f] = keep[f]
+    return out
+
+
+def plot_references(nav, hz, kinds, gate, path):
+    """The navigation with references: the mode and the references in use,
+    each used kind's NIS with the gate, the filter's sigmas."""
+    plt = pyplot()
+    t, tl = time_axis(nav["tick"] / hz)
+    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    slots = {name: abi_kind - 1 for name, abi_kind in kinds.items()}
+    rows = [("integrated", (nav["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float))]
+    rows += [(f"{name} in use", ((nav["ref_in_use"] >> s) & 1).astype(float))
+             for name, s in sorted(slots.items(), key=lambda kv: kv[1])]
+    for j, (label, on) in enumerate(rows):      # one lane each: up while on
+        ax[0].step(t, on * 0.6 + j, where="post", lw=1.2, color="k" if j == 0 else f"C{j - 1}")
+    ax[0].set_yticks([j + 0.3 for j in range(len(rows))], [label for label, _ in rows], fontsize=8)
+    ax[0].set_ylim(-0.3, len(rows))
+    for name, s in sorted(slots.items(), key=lambda kv: kv[1]):
+        nis = nav["nav_nis"][:, s]
+        ok = nis > 0.0
+        if ok.any():
+            ax[1].semilogy(t[ok], nis[ok], ".", ms=2, label=f"{name} NIS")
+    ax[1].axhline(gate, color="r", lw=0.8, ls="--", label=f"gate {gate:.4g}")
+    ax[1].set_ylabel("normalised innovation")
+    line(ax[2], t, nav["nav_sigma_pos_m"], label="position sigma [m]")
+    ax2 = ax[2].twinx()
+    ax2.plot(t, nav["nav_sigma_heading_rad"] / ARCMIN_TO_RAD, color="C1", lw=0.8, label="heading sigma [']")
+    ax2.set_ylabel("heading sigma [arcmin]")
+    ax[2].set_ylabel("position sigma [m]")
+    ax[2].set_xlabel(tl)
+    for a in ax:
+        a.grid(alpha=0.3)
+    for a in ax[1:]:
+        a.legend(fontsize=8, loc="upper right")
+    ax2.legend(fontsize=8, loc="center right")
+    ax[0].set_title("navigation with external references: the mode and the references in use (up: on)",
+                    fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def _records(path):
     """The records the figures draw, read in blocks (`pyins.logs.iter_npz`), so
     the page of a 72 h replay does not hold its 259,200 records (112 MB):
@@ -178,15 +247,18 @@ def _records(path):
     share of MAX_POINTS a curve; plot_attitude's envelope of them is the
     whole log's), and every fine-alignment record."""
     n = logs.npz_shape(path, "outputs")[0]
-    kept, fine = [], []
+    kept, fine, nav = [], [], []
     for rows in logs.iter_npz(path, "outputs", block=_RECORD_BLOCK):
-        kept.append(_kept(rows, max(16, MAX_POINTS * len(rows) // max(n, 1))).copy())
+        budget = max(16, MAX_POINTS * len(rows) // max(n, 1))
+        kept.append(_kept(rows, budget).copy())
         fine.append(rows[rows["mode"] == abi.PYINS_MODE_FINE_ALIGN].copy())
+        if "nav_nis" in rows.dtype.names:   # (records of ABI 0.15 on)
+            nav.append(_nav_kept(rows, budget))
     if not kept:                        # no record: the empty array as it is
         with np.load(path, allow_pickle=False) as z:
             rec = z["outputs"]
-        return rec, rec
-    return np.concatenate(kept), np.concatenate(fine)
+        return rec, rec, None
+    return np.concatenate(kept), np.concatenate(fine), np.concatenate(nav) if nav else None
 
 
 def render(out_dir):
@@ -198,7 +270,7 @@ def render(out_dir):
             summary[part] = {k: (float("nan") if v is None and k != "time_s" else
                                  [float("nan") if x is None else x for x in v] if isinstance(v, list) else v)
                              for k, v in summary[part].items()}
-    rec, fine = _records(os.path.join(out_dir, "navigation.npz"))
+    rec, fine, nav = _records(os.path.join(out_dir, "navigation.npz"))
     hz = summary.get("rate_hz", 100)
     figures = []
     if len(rec):
@@ -206,6 +278,11 @@ def render(out_dir):
         figures.append("attitude.png")
         if plot_alignment(fine, hz, os.path.join(out_dir, "alignment.png")):
             figures.append("alignment.png")
+    refs = summary.get("references") if isinstance(summary.get("references"), dict) else None
+    if refs and nav is not None and len(nav):
+        kinds = {name: contract.REF_KINDS[name] for name in refs.get("kinds", {}) if name in contract.REF_KINDS}
+        plot_references(nav, hz, kinds, refs.get("gate", DEFAULT_NAV_GATE), os.path.join(out_dir, "references.png"))
+        figures.append("references.png")
     errors_path = os.path.join(out_dir, "errors.npz")
     if os.path.exists(errors_path):
         with np.load(errors_path, allow_pickle=False) as z:
@@ -240,6 +317,11 @@ def render(out_dir):
     faults = abi.fault_names(fin["fault_flags"])
     rows.append(_row("final", f"{MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
                               f"{fin['lon_deg']:.6f} E; faults: {', '.join(faults) or 'none'}"))
+    for name, k in (refs or {}).get("kinds", {}).items():
+        rows.append(_row(f"references {name}",
+                         f"{k['given']} given, {k['used']} used, {k['rejected']} rejected by the gate, "
+                         f"{k['stale']} repeats unused, {k['skipped']} before navigation, "
+                         f"{k['after_end']} after the log's end"))
     er = summary.get("errors")
     if er and summary.get("navigating_records") == 0:
         rows.append(_row(f"against {er.get('reference', 'the truth')}",
