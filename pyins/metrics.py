@@ -15,7 +15,9 @@ Two scopes:
   are no INS error), "nav" for every run with records, "alignment" when the
   firmware aligns (the theoretical limit of an alignment, seed 001 eq. 21),
   "static_fine" when a fine alignment runs on a static base (seed 001: the
-  filter's errors beside the limits).
+  filter's errors beside the limits), "aided" for a run that navigates
+  with external references ([references] in its scenario), "outages" for
+  one whose GNSS positions have gaps (KF-GINS's outage figure).
 - "group": over the runs of one scenario or campaign group (seeds,
   headings): seed 000's Table 1 std (`group_metrics`).
 
@@ -125,6 +127,13 @@ class _Run:
         self.nav = nav if nav.any() else np.ones(len(nav), bool)
 
     @cached_property
+    def outage_drifts(self):
+        """The largest horizontal error of each GNSS outage (`gnss_outages`) [m]."""
+        t = self.err.time_s
+        return np.array([self.err.horizontal_m[(t >= a) & (t <= b)].max(initial=0.0)
+                         for a, b in gnss_outages(self.spec.refs, self.spec.dt, t[-1])])
+
+    @cached_property
     def final_limits(self):
         """The alignment limits at the final true attitude (seed 001 eq. 21)."""
         return analysis.alignment_limits(float(self.res.truth.lat[-1]), self.res.truth.euler[-1],
@@ -219,6 +228,21 @@ TABLE = (
     _m("velocity_error_max", "velocity", "m/s", 1.0,
        "largest horizontal velocity error component while navigating (after the alignment, if any)",
        lambda r: float(np.abs(r.err.vel_n_mps[r.nav, :2]).max()), stage="position"),
+    _m("horizontal_error_rms", "length", "m", _M,
+       "RMS horizontal position error while navigating (a run with external references: "
+       "[references] in its scenario)",
+       lambda r: float(np.sqrt(np.mean(r.err.horizontal_m[r.nav] ** 2))), stage="aided"),
+    _m("heading_error_rms", "angle", "arcmin", _ARCMIN,
+       "RMS |phi_U| while navigating (a run with external references)",
+       lambda r: float(np.sqrt(np.mean(r.att[r.nav, 2] ** 2))), stage="aided"),
+    _m("references_rejected", "dimensionless", "", 1.0,
+       "references the firmware's innovation gate rejected, all kinds (a run with external "
+       "references)",
+       lambda r: float(np.sum(r.res.outputs["n_ref_rejected"][-1])), stage="aided", figure=False),
+    _m("outage_drift_rms", "length", "m", _M,
+       "RMS over the GNSS outages (gaps of more than 2.5 fix intervals in the position fixes) of each "
+       "outage's largest horizontal error (KF-GINS's figure: 60-s outages every 180 s)",
+       lambda r: float(np.sqrt(np.mean(np.square(r.outage_drifts)))), stage="outages"),
     _m("level_error_std", "angle", "arcsec", _ARCSEC,
        "std of the final pitch and roll errors over the runs of a campaign (seeds, headings)",
        lambda vs: float(_std(vs)[:2].max()), stage="group"),
@@ -256,7 +280,7 @@ NAMES = tuple(_BY_NAME)                                            #: every metr
 FIGURE_METRICS = tuple(m.name for m in TABLE if m.figure)           #: what [paper] figures name
 RUN_METRICS = tuple(m.name for m in TABLE if m.scope == "run")
 GROUP_METRICS = tuple(m.name for m in TABLE if m.scope == "group")
-_STAGES = ("position", "nav", "alignment", "static_fine")
+_STAGES = ("position", "aided", "outages", "nav", "alignment", "static_fine")
 
 
 # ---------------------------------------------------------------------------
@@ -271,13 +295,36 @@ def _stages(spec):
         yield "static_fine"
 
 
+def gnss_outages(refs, dt, end_s=None):
+    """The GNSS outages of references ``refs`` (REF_DTYPE, or None): the gaps
+    between position fixes longer than 2.5 times their usual interval (the
+    median), as [(start, end)] in seconds, from the last fix before a gap to
+    the first after it; with ``end_s`` (the run's end) also the time after
+    the last fix when it is such a gap."""
+    if refs is None:
+        return []
+    ticks = refs["tick"][refs["kind"] == abi.PYINS_REF_GNSS_POS]
+    if len(ticks) < 3:
+        return []
+    gaps = np.diff(ticks)
+    usual = float(np.median(gaps))
+    big = np.flatnonzero(gaps > 2.5 * usual)
+    out = [(float(ticks[i] * dt), float(ticks[i + 1] * dt)) for i in big]
+    if end_s is not None and end_s - ticks[-1] * dt > 2.5 * usual * dt:
+        out.append((float(ticks[-1] * dt), float(end_s)))
+    return out
+
+
 def run_metrics(spec, res):
     """The run metrics of one run (SI units): ``res`` holds its records
     and truth (a records.FilResult); {} when it has no records."""
     if len(res.outputs) == 0:
         return {}
     run = _Run(spec, res)                                            # 1.
-    stages = [*(["position"] if run.navigates else []), *_stages(spec)]
+    stages = [*(["position"] if run.navigates else []),
+              *(["aided"] if run.navigates and getattr(spec, "refs", None) is not None else []),
+              *(["outages"] if run.navigates and gnss_outages(getattr(spec, "refs", None), spec.dt) else []),
+              *_stages(spec)]
     return {m.name: m.compute(run) for m in TABLE if m.stage in stages}   # 2-4., in the table's order
 
 

@@ -40,7 +40,7 @@ def run(spec, engine="native", **kwargs):
     progress, ...). Returns a records.FilResult."""
     return fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=spec.errors,
                        seed=spec.seed, table=spec.table, every=spec.every, dt=spec.dt, engine=engine,
-                       **kwargs)
+                       refs=spec.refs, avail_tick=spec.avail_tick, **kwargs)
 
 
 def _entry(spec, written):

@@ -35,10 +35,11 @@ import os
 
 import numpy as np
 
-from pyins import metrics, records, rundir
+from pyins import contract, metrics, records, rundir
 from pyins.metrics import FIGURE_METRICS, display
 from pyins.progress import phase
 from pyins.reference import abi, earth
+from pyins.reference.config import DEFAULT_NAV_GATE
 from pyins.report.paper import not_judged, paper_rows, span
 from pyins.report.plotting import cycle_window, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, NMI_TO_M
@@ -241,6 +242,71 @@ def plot_errors(summary, series, path):
                                      "held, no position error to show)"), fontsize=10)
     fig.tight_layout()
     _save(fig, path, plt)
+
+
+def aided(s):
+    """True when a variant's records show external references used."""
+    out = s["outputs"]
+    return "n_ref_used" in out.dtype.names and int(np.sum(out["n_ref_used"][-1])) > 0
+
+
+def _spans(t, on):
+    """The (t0, t1) spans where ``on`` holds (records in order)."""
+    d = np.diff(np.concatenate([[0], np.asarray(on, bool).astype(np.int8), [0]]))
+    return [(t[a], t[b - 1]) for a, b in zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1))]
+
+
+def plot_references(summary, series, path):
+    """Navigation with external references, a column per variant that used
+    them: the horizontal error with the filter's 3-sigma envelope (spans
+    without GNSS position shaded), each kind's normalised innovation with
+    the gate, and the mode and the references in use over time. False when
+    no variant used references."""
+    used = {label: s for label, s in series.items() if aided(s)}
+    if not used:
+        return False
+    plt = pyplot()
+    fig, ax = plt.subplots(3, len(used), figsize=(6.4 * len(used) + 1.0, 9), sharex="col", squeeze=False)
+    ts, tl = _clock(series)
+    gate = DEFAULT_NAV_GATE         # (no scenario key sets another)
+    for j, (label, s) in enumerate(used.items()):
+        out = s["outputs"]
+        nav = out["mode"] == abi.PYINS_MODE_NAVIGATE
+        t = s["time_s"][nav] / ts
+        o = out[nav]
+        hor = s["horizontal_m"][nav]
+        no_fix = (o["ref_in_use"] & (1 << (abi.PYINS_REF_GNSS_POS - 1))) == 0
+        for a, b in _spans(t, no_fix):
+            for k in range(3):
+                ax[k, j].axvspan(a, b, color="0.9", lw=0, zorder=0)
+        line(ax[0, j], t, hor, lw=0.8, label="horizontal error")
+        line(ax[0, j], t, 3.0 * o["nav_sigma_pos_m"], lw=0.8, color="C3", label="filter's 3 sigma")
+        ax[0, j].set_yscale("log")       # centimetres aided, metres coasting, the prior's tens at the start
+        ax[0, j].set_ylabel("horizontal [m]")
+        ax[0, j].set_title(f"{label}: shaded, no GNSS position in use", fontsize=9)
+        kinds = [k for k in range(o["nav_nis"].shape[1]) if int(o["n_ref_used"][-1, k]) > 0]
+        names = {v - 1: name for name, v in contract.REF_KINDS.items()}
+        for k in kinds:
+            nis = o["nav_nis"][:, k]
+            ok = nis > 0.0
+            if ok.any():
+                ax[1, j].semilogy(t[ok], nis[ok], ".", ms=1.5, label=f"{names[k]} NIS")
+        ax[1, j].axhline(gate, color="r", lw=0.8, ls="--", label=f"gate {gate:.4g}")
+        ax[1, j].set_ylabel("normalised innovation (last)")
+        lanes = [("integrated", (o["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float))]
+        lanes += [(f"{names[k]} in use", ((o["ref_in_use"] >> k) & 1).astype(float)) for k in kinds]
+        for i, (name, on) in enumerate(lanes):
+            ax[2, j].step(t, on * 0.6 + i, where="post", lw=1.0, color="k" if i == 0 else f"C{i - 1}")
+        ax[2, j].set_yticks([i + 0.3 for i in range(len(lanes))], [n for n, _ in lanes], fontsize=8)
+        ax[2, j].set_ylim(-0.3, len(lanes))
+        ax[2, j].set_xlabel(tl)
+        for k in range(2):
+            ax[k, j].legend(fontsize=8, loc="upper right")
+        for k in range(3):
+            ax[k, j].grid(alpha=0.3)
+    fig.tight_layout()
+    _save(fig, path, plt)
+    return True
 
 
 def plot_alignment(summary, series, path):
@@ -523,6 +589,11 @@ def render(run_dir, loaded=None, progress=None):
              ("table.png", "Turntable angle and IMU heading (zoom: a few cycles)"
               + (", the flexible scheme's sums A_c, A_s" if any(v.get("uses_index_sums") for v in summary["variants"])
                  else ""), lambda p: plot_table(summary, series, p))] if series else []
+    if series:
+        plots.append(("references.png", "Navigation with external references: the horizontal error and the "
+                      "filter's 3-sigma envelope (shaded: no GNSS position in use), the normalised "
+                      "innovations and the gate, the mode and the references in use",
+                      lambda p: plot_references(summary, series, p)))
     plots.append(("comparison.png", "Scheme comparison", lambda p: plot_comparison(summary, p)))
     with phase(progress, "report: figures"):
         for name, caption, draw in plots:

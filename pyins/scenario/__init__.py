@@ -59,6 +59,7 @@ from pyins.scenario.resolve import (_ALTERNATIVES, _NOT_COMPARABLE, _check_key_p
 from pyins.scenario.schema import (COARSE_METHODS, COMPARE_KEYS, COMPONENT_KEYS, FINE_CORRECTIONS,
                                    FINE_NOISES, FIGURE_KEYS, INDEX_SCHEMES, INDEX_SUMS, METRICS, MOTION_COMMON, MOTION_KINDS, SCHEMA_VERSION, SEGMENT_KEYS,
                                    SHIP_KEYS, SPECTRUM_KEYS, STEP_KEYS, TABLES, TOP_KEYS, VERTICAL_MODES,
+                                   GNSS_KEYS, NAV_MODES, REFERENCE_TABLES, WINDOW_KEYS, ZERO_VELOCITY_KEYS,
                                    Key)
 from pyins.scenario.values import _need_table, _read
 from pyins.units import DT, TICK_HZ, UNITS, ScenarioError

@@ -14,9 +14,9 @@ import numpy as np
 from pyins import contract, limits, sim
 from pyins import engine as engines
 from pyins.reference import attitude, earth
-from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, FINE_NOISES, INDEX_SUMS, VERTICAL_MODES,
+from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, FINE_NOISES, INDEX_SUMS, NAV_MODES, VERTICAL_MODES,
                                    _LINEAR_AXES, _STEP_MOVES, _TABLE_FAULTS)
-from pyins.sim import turntable
+from pyins.sim import references, turntable, voyage
 from pyins.units import DT, TICK_HZ, ScenarioError
 
 # ---------------------------------------------------------------------------
@@ -61,6 +61,13 @@ def _build_base_motion(m):
     if kind == "heading_swing":
         return sim.HeadingSwing(lat, lon, h, m["pitch_rad"], m["roll_rad"], m["yaw_rad"],
                                 m["rate_amplitude_rad_s"], m["period_s"])
+    if kind == "voyage":
+        yaw0, speed0, legs = voyage.voyage_segments(m["duration_s"] / 3600.0, seed=m["route_seed"], dt=DT)
+        if m["yaw_rad"] is not None:
+            yaw0 = m["yaw_rad"]
+        return sim.Voyage(lat, lon, h, yaw0, legs, speed0=speed0, dt=DT,
+                          sea=None if m["sea"] == "none" else m["sea"], pitch0=m["pitch_rad"],
+                          roll0=m["roll_rad"])
     if m["segments"] == "default":
         segments = sim.default_segments(DT)
     else:
@@ -189,6 +196,8 @@ def _firmware_config(res, motion):
         cfg["fine_noise"] = FINE_NOISES[fw["fine_noise"]]
     if fw.get("coarse_method") is not None:
         cfg["coarse_method"] = COARSE_METHODS[fw["coarse_method"]]
+    if fw.get("nav_mode") is not None:
+        cfg["nav_mode"] = NAV_MODES[fw["nav_mode"]]
     if fw.get("lever") == "unknown":
         # what an unknown lever arm costs: the firmware navigates the reference point as if
         # the accelerometers were there (initial_config would give it the motion's)
@@ -294,15 +303,54 @@ class RunSpec:
     every: int                    #: record interval [ticks]
     dt: float = DT
     outputs: dict = None          #: the resolved [outputs] (plots, csv, records)
+    refs: object = None           #: external references (contract.REF_DTYPE) or None
+    avail_tick: object = None     #: the tick each reaches the firmware (a receiver's latency), or None
+
+
+def _references(res, motion):
+    """(refs, avail_tick) of the resolved [references]: the simulated GNSS
+    receiver's fixes and the zero-velocity declarations, merged by tick
+    (`pyins.sim.references`); (None, None) without any."""
+    rt = res.get("references")
+    if not rt:
+        return None, None
+    duration = res["duration_s"]
+    parts = []
+    g = rt.get("gnss")
+    if g is not None:
+        outages = [tuple(w) for w in g["outages"]]
+        if g["outage_every_s"]:
+            t = g["outage_from_s"]
+            while t < duration:
+                outages.append((t, t + g["outage_length_s"]))
+                t += g["outage_every_s"]
+        parts.append(references.gnss(motion, duration, dt=DT, rate_hz=g["rate_hz"], pos_noise_m=g["pos_noise_m"],
+                                     vel_noise_mps=g["vel_noise_mps"], bias_sigma_m=g["bias_sigma_m"],
+                                     bias_tau_s=g["bias_tau_s"], latency_s=g["latency_s"], outages=outages,
+                                     outlier_rate=g["outlier_rate"], frozen=[tuple(w) for w in g["frozen"]],
+                                     seed=g["seed"], velocity=g["velocity"]))
+    z = rt.get("zero_velocity")
+    if z is not None:
+        fw = res["firmware"]
+        start = z["start_s"] if z["start_s"] is not None else (fw["coarse_time_s"] or 0.0) + (fw["fine_time_s"] or 0.0)
+        parts.append(references.zero_velocity(max(duration - start, 0.0), rate_hz=z["rate_hz"],
+                                              sigma_mps=z["sigma_mps"], t0_s=start, dt=DT))
+    merged = references.merge(*parts) if len(parts) > 1 else parts[0]
+    refs = np.ascontiguousarray(merged.refs, dtype=contract.REF_DTYPE)
+    # a ship's computer receives them in order: one reaches it no earlier than
+    # those before it (a receiver's latency beside undelayed declarations)
+    avail = np.maximum.accumulate(np.asarray(merged.avail_tick, dtype=np.int64))
+    return refs, avail
 
 
 def _runspec(res, label, index):
     """The RunSpec of one resolved variant."""
     motion = _build_motion(res["motion"])
+    refs, avail = _references(res, motion)
     return RunSpec(label=label, index=index, scenario=res["name"], motion=motion,
                    errors=_sensor_errors(res["sensors"]), config=_firmware_config(res, motion),
                    table=_table_config(res["turntable"]), duration_ticks=_ticks(res["duration_s"]),
                    seed=res["seed"], every=_ticks(res["record_every_s"]), dt=DT,
-                   outputs=dict(res["outputs"]))
+                   outputs=dict(res["outputs"]), refs=refs, avail_tick=avail)
 
 

@@ -20,7 +20,8 @@ from pyins.scenario.schema import (COMPONENT_KEYS, FIGURE_KEYS, FIRMWARE_KEYS, I
                                    INDEXING_KEYS, INITIAL_ERROR_KEYS, METRICS, MOTION_COMMON,
                                    MOTION_KINDS, OUTPUT_KEYS, PAPER_KEYS, SCHEMA_VERSION, SEGMENT_KEYS,
                                    SENSOR_KEYS, SHIP_KEYS, SPECTRUM_KEYS, STEP_KEYS, TABLE_NAMES, TABLES,
-                                   TOP_KEYS, TURNTABLE_KEYS, _FIXED_KINDS, _LINEAR_AXES, _SUFFIX)
+                                   TOP_KEYS, TURNTABLE_KEYS, _FIXED_KINDS, _LINEAR_AXES, _SUFFIX,
+                                   REFERENCE_TABLES, WINDOW_KEYS)
 from pyins.scenario.values import (_array_of_tables, _check_keys, _convert, _join, _need_table, _read,
                                    _si, _suggest, _type_name)
 from pyins.sim import motion as sim_motion
@@ -74,6 +75,8 @@ def _resolve_motion(table, duration_s):
             raise ScenarioError("give either yaw or heading, not both", "motion.heading")
         v["yaw"] = -v["heading"]
     del v["heading"]
+    if kind == "voyage" and "yaw" not in table and "heading" not in table:
+        v["yaw"] = None           # the route's own initial course
     ship = {name: v.pop(name) for name in SHIP_KEYS if name in keys}
     ship = {name: value for name, value in ship.items() if name in table}
     res = _si(v, keys)
@@ -83,6 +86,8 @@ def _resolve_motion(table, duration_s):
             sim.node_rates(_build_motion(res), np.arange(1), dt=DT)
         except ValueError as exc:
             raise ScenarioError(str(exc), "motion.lever_p") from None
+    if kind == "voyage":
+        res["duration_s"] = duration_s      # the route is cut there (a longer one extends it)
     if kind == "manoeuvre":
         res["segments"] = _resolve_segments(v["segments"])
         length = _build_motion(res).duration
@@ -272,6 +277,52 @@ def _resolve_firmware(table, duration_s):
     return _si(v, FIRMWARE_KEYS)
 
 
+def _windows(raw, where, duration_s):
+    out = []
+    for i, w in enumerate(_array_of_tables(raw or [], where, 0, 10_000)):
+        p = f"{where}[{i}]"
+        v = _read(w, p, WINDOW_KEYS)
+        if not v["end"] > v["start"]:
+            raise ScenarioError(f"end ({v['end']:g} s) must be after start ({v['start']:g} s)", f"{p}.end")
+        out.append([v["start"], v["end"]])
+    return out
+
+
+def _resolve_references(table, duration_s, firmware):
+    """[references]: {gnss: {...}, zero_velocity: {...}}, each only when
+    given (SI, the windows as [start_s, end_s] pairs)."""
+    _need_table(table, "references")
+    _check_keys(table, "references", list(REFERENCE_TABLES))
+    if table and firmware.get("nav_mode") == "undamped":
+        raise ScenarioError("the firmware takes no references with nav_mode = 'undamped'",
+                            "firmware.nav_mode")
+    out = {}
+    for name, keys in REFERENCE_TABLES.items():
+        if name not in table:
+            continue
+        path = f"references.{name}"
+        sub = _need_table(table[name], path)
+        v = _read(sub, path, keys)
+        for rate_key in ("rate",):
+            step = 1.0 / (v[rate_key] * DT)
+            if abs(step - round(step)) > 1e-6 or round(step) < 1:
+                raise ScenarioError(f"{v[rate_key]:g} Hz: 1 / rate must be a whole number of ticks "
+                                    f"({DT:g} s)", f"{path}.{rate_key}")
+        if name == "gnss":
+            v["outages"] = _windows(v["outages"], f"{path}.outages", duration_s)
+            v["frozen"] = _windows(v["frozen"], f"{path}.frozen", duration_s)
+            if v["outage_every"] and v["outage_length"] >= v["outage_every"]:
+                raise ScenarioError(f"{v['outage_length']:g} s: an outage must be shorter than the "
+                                    f"interval outage_every ({v['outage_every']:g} s)",
+                                    f"{path}.outage_length")
+        keys_si = {k: key for k, key in keys.items() if k not in ("outages", "frozen")}
+        res = _si({k: v[k] for k in keys_si}, keys_si)
+        if name == "gnss":
+            res["outages"], res["frozen"] = v["outages"], v["frozen"]
+        out[name] = res
+    return out
+
+
 def _resolve_initial_errors(table, firmware):
     _need_table(table, "initial_errors")
     v = _read(table, "initial_errors", INITIAL_ERROR_KEYS)
@@ -339,6 +390,9 @@ def _resolve(data, stem):
         del firmware["coarse_method"]
     if firmware["lever"] == "configured" and not _is_ship(motion):
         del firmware["lever"]
+    if firmware["nav_mode"] is None:
+        del firmware["nav_mode"]
+    references = _resolve_references(data.get("references", {}), duration_s, firmware)
     res = {
         "schema": SCHEMA_VERSION,
         "name": name,
@@ -356,6 +410,8 @@ def _resolve(data, stem):
         "initial_errors": _resolve_initial_errors(data.get("initial_errors", {}), firmware),
         "outputs": _read(_need_table(data.get("outputs", {}), "outputs"), "outputs", OUTPUT_KEYS),
     }
+    if references:
+        res["references"] = references
     return res
 
 

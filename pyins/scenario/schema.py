@@ -63,19 +63,20 @@ TOP_KEYS = {
 }
 
 TABLE_NAMES = ("motion", "sensors", "turntable", "indexing", "firmware", "initial_errors",
-               "compare", "paper", "outputs")
+               "references", "compare", "paper", "outputs")
 
 _LAT_DEFAULT, _LON_DEFAULT = "34.246 deg", "108.910 deg"
 MOTION_COMMON = {
     "kind": Key("choice", "motion profile", required=True,
-                choices=("static", "swing", "sea_state", "heading_swing", "manoeuvre")),
+                choices=("static", "swing", "sea_state", "heading_swing", "manoeuvre", "voyage")),
     "lat": _angle("geodetic latitude", _LAT_DEFAULT, "-89.9 deg", "89.9 deg"),
     "lon": _angle("longitude", _LON_DEFAULT, "-360 deg", "360 deg"),
     "height": Key("length", "height above the WGS-84 ellipsoid", "0 m", lo="-10 km", hi="100 km"),
     "pitch": _angle("pitch (swing: mean pitch)", "0 deg", "-89.9 deg", "89.9 deg"),
     "roll": _angle("roll (swing: mean roll)", "0 deg", "-180 deg", "180 deg"),
     "yaw": _angle("yaw, counter-clockwise from North (swing: mean; heading swing, "
-                  "manoeuvre: initial)", "0 deg", "-360 deg", "360 deg"),
+                  "manoeuvre, voyage: initial; a voyage without it starts on its route's course)",
+                  "0 deg", "-360 deg", "360 deg"),
     "heading": _angle("marine heading, clockwise from North: yaw = -heading (give yaw or "
                       "heading)", None, "-360 deg", "360 deg"),
 }
@@ -104,6 +105,15 @@ MOTION_KINDS = {
         "speed": Key("velocity", "initial speed", "0 m/s", lo="0 m/s", hi="100 m/s"),
         "segments": Key("tables", "'default' (the 30-min manoeuvre) or legs "
                                   "{kind, duration, speed | angle}", "default"),
+    },
+    "voyage": {
+        "route_seed": Key("int", "seed of the transit's legs (pyins.sim.voyage_segments: a first leg "
+                                 "of 10-20 min, then course changes of 20-120 deg at 0.5-1 deg/s, "
+                                 "every other one with a speed change within 5-20 kn, legs of "
+                                 "30-60 min; the initial course and speed, 8-16 kn)", default=0, lo=0),
+        "sea": Key("choice", "the swing of seed 000 Table 2 on top of the track ('none': a flat sea); "
+                             "the voyage heaves 0.5 m at 8 s", "general",
+                   choices=("general", "ideal", "bad", "none")),
     },
 }
 SEGMENT_KEYS = {
@@ -227,6 +237,8 @@ STEP_KEYS = {
 }
 
 #: the firmware's enums by the names scenario files and the CLI use
+NAV_MODES = {"auto": abi.PYINS_NAV_AUTO, "undamped": abi.PYINS_NAV_UNDAMPED,
+             "integrated": abi.PYINS_NAV_INTEGRATED}
 VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
 FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
 FINE_NOISES = {"measured": abi.PYINS_FINE_NOISE_MEASURED, "configured": abi.PYINS_FINE_NOISE_CONFIGURED}
@@ -277,6 +289,10 @@ FIRMWARE_KEYS = {
                             lo_open=True),
     "fine_sigma0_accel": Key("acceleration", "initial sigma of the biases (firmware default "
                                              "100 ug)", lo="0 ug", hi="1 g", lo_open=True),
+    "nav_mode": Key("choice", "navigation: 'auto' (integrated while a reference is in use, else "
+                              "undamped), 'undamped' (free inertial, references refused) or "
+                              "'integrated' (firmware default auto)", choices=("auto", "undamped",
+                                                                               "integrated")),
     "fine_site_accel": Key("velocity_random_walk", "moving base (fine_states 12): the site's slow "
                                                    "horizontal motion, a ship ranging on its lines, as "
                                                    "a white acceleration density (firmware default 0: "
@@ -326,6 +342,48 @@ OUTPUT_KEYS = {
     "csv": Key("bool", "write CSV tables of the records", default=True),
     "records": Key("bool", "keep the raw decimated records (outputs.bin, plant.bin)", default=False),
 }
+
+#: Keys of [references.gnss]: a simulated receiver (pyins.sim.references.gnss)
+#: whose fixes the firmware navigates with (docs/concepts.md, "At sea").
+GNSS_KEYS = {
+    "rate": Key("frequency", "fix rate (1 / rate a whole number of ticks)", "1 Hz", lo="0 Hz",
+                hi="100 Hz", lo_open=True),
+    "pos_noise": Key("length", "white noise of the position, [E, N, U] 1-sigma", "3 m", lo="0 m",
+                     hi="1 km", lo_open=True, shape=3),
+    "vel_noise": Key("velocity", "white noise of the velocity, per axis", "0.05 m/s", lo="0 m/s",
+                     hi="10 m/s", lo_open=True),
+    "bias_sigma": Key("length", "first-order Gauss-Markov position bias, 1-sigma per axis (0: none)",
+                      "2 m", lo="0 m", hi="1 km"),
+    "bias_tau": Key("time", "the bias's correlation time (not only whole ticks)", "300 s", lo="0 s",
+                    hi="30 d", lo_open=True),
+    "latency": _time("the receiver's latency: a fix reaches the firmware this long after its "
+                     "tick (at most the firmware's 1 s)", "0 s", hi="1 s"),
+    "outages": Key("tables", "outages {start, end}: no fix in [start, end)"),
+    "outage_every": _time("periodic outages (KF-GINS's protocol: 180 s): one every ... (0: none)",
+                          "0 s"),
+    "outage_length": _time("periodic outages: each lasts ... (KF-GINS's: 60 s)", "60 s",
+                           lo="0 s", lo_open=True),
+    "outage_from": _time("periodic outages: the first starts at ...", "0 s"),
+    "outlier_rate": Key("dimensionless", "share of fixes jumped 50-500 m (multipath)", 0.0, lo=0,
+                        hi=1),
+    "frozen": Key("tables", "a frozen receiver {start, end}: the last fix before start repeated"),
+    "seed": Key("int", "seed of the receiver's noise (not the IMU's)", default=0, lo=0),
+    "velocity": Key("bool", "give velocity fixes beside the positions", default=True),
+}
+#: Keys of one window of [references.gnss] outages or frozen.
+WINDOW_KEYS = {
+    "start": _time("start of the window", required=True, hi="30 d"),
+    "end": _time("end of the window (after its start)", required=True, hi="30 d"),
+}
+#: Keys of [references.zero_velocity]: declarations that the ship is at rest.
+ZERO_VELOCITY_KEYS = {
+    "rate": Key("frequency", "declarations per second (1 / rate a whole number of ticks)", "1 Hz",
+                lo="0 Hz", hi="100 Hz", lo_open=True),
+    "sigma": Key("velocity", "sigma per axis", "0.01 m/s", lo="0 m/s", hi="10 m/s", lo_open=True),
+    "start": _time("the first declaration after ... (default: the end of the alignment)", None),
+}
+#: [references] sub-tables -> their keys
+REFERENCE_TABLES = {"gnss": GNSS_KEYS, "zero_velocity": ZERO_VELOCITY_KEYS}
 
 #: table name -> its keys (motion: the common keys; kinds add theirs).
 TABLES = {"motion": MOTION_COMMON, "sensors": SENSOR_KEYS, "turntable": TURNTABLE_KEYS,

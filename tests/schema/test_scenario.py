@@ -22,7 +22,8 @@ DEG = units.DEG_TO_RAD
 BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001_fine8",
             "seed002_exp1", "seed002_exp2", "seed003",
             "moored_bad", "moored_general", "moored_ideal", "moored_spectrum",   # test_scenario_ship.py
-            "harbour_ranging"]                                                  # test_harbour_ranging.py
+            "harbour_ranging",                                                  # test_harbour_ranging.py
+            "voyage_gnss", "voyage_gnss_outages"]                               # tests/atsea/test_scenario_refs.py
 
 
 def _tool(name):
@@ -216,7 +217,8 @@ def test_demo_builtin_matches_pyins_demo():
 def test_docs_name_every_key_and_builtin():
     doc = (ROOT / "docs" / "scenarios.md").read_text()
     tables = [scenario.TOP_KEYS, scenario.STEP_KEYS, scenario.SEGMENT_KEYS, scenario.FIGURE_KEYS,
-              *scenario.TABLES.values(), *scenario.MOTION_KINDS.values()]
+              *scenario.TABLES.values(), *scenario.MOTION_KINDS.values(),
+              *scenario.REFERENCE_TABLES.values(), scenario.WINDOW_KEYS]
     for keys in tables:
         for name in keys:
             assert f"`{name}`" in doc, name
