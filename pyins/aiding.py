@@ -150,7 +150,7 @@ def run_with_refs(fw, samples, refs, every=100, avail_tick=None, compact=False, 
 
 class BlockFeed:
     """The references of a replay, block by block: a file's (REF_DTYPE,
-    ticks on the log's clock: tick 0 is its first sample) and, when
+    ticks on the log's clock: tick T is the end of its T-th sample) and, when
     ``zero_velocity_mps`` is given, a zero-velocity declaration every second
     from ``zv_from_tick`` on (a vehicle or a ship at rest after its
     alignment). The log's length need not be known: `run` steps one block
@@ -246,8 +246,12 @@ class BlockFeed:
                     if end - inside[-1] > 10.0:
                         warn.append(f"the references end {end - inside[-1]:g} s before the log does: "
                                     f"unaided from {inside[-1]:g} to {end:g} s")
+        # the gate (chi-square, 2 degrees of freedom, 0.999) rejects 1 in 1000 good references by
+        # chance: more than 1 % is the references or the filter's model being off
         for name, k in kinds.items():
-            if k["rejected"]:
-                warn.append(f"{k['rejected']} of the {k['given']} {name} references failed the "
-                            "innovation gate and were not used")
+            tested = k["used"] + k["rejected"]
+            if k["rejected"] > max(1, 0.01 * tested):
+                warn.append(f"{k['rejected']} of the {tested} {name} references tested failed the "
+                            "innovation gate and were not used (more than 1 %: the gate alone rejects "
+                            "0.1 % by chance): the references, their sigmas or the navigation are off")
         return facts, warn

@@ -78,7 +78,7 @@ def add_replay(cmd):
                         "(docs/cli.md, \"pyins replay\")")
     p.add_argument("--refs", metavar="FILE",
                    help="external references used in navigation (GNSS position and velocity, zero "
-                        "velocity), ticks on the log's clock (tick 0 its first sample): the text layout "
+                        "velocity), ticks on the log's clock (tick T: the end of its T-th sample): the text layout "
                         "'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, \"Reference files\")")
     p.add_argument("--zero-velocity", nargs="?", const="0.01 m/s", metavar="SIGMA",
                    help="the vehicle or ship at rest after its alignment: a zero-velocity reference every "

@@ -1,9 +1,11 @@
 """`pyins simulate`: a scenario's IMU log written as a field log would be."""
+import os
 import sys
 
 import numpy as np
 
 from pyins import logs, scenario, sim
+from pyins.sim import references
 
 from .common import EXIT_OK, InputError, check_hours, emit_json, progress_hook, say
 
@@ -22,6 +24,10 @@ def add_simulate(cmd):
     p.add_argument("--format", help="npz, csv, text, binary (default: from the extension)")
     p.add_argument("--hours", type=float)
     p.add_argument("--variant", type=int, default=0, help="which [compare] variant (default 0)")
+    p.add_argument("--refs", metavar="FILE",
+                   help="also write the scenario's external references ([references]: GNSS fixes, "
+                        "zero velocity) to FILE on the log's clock, for `pyins replay --refs FILE` "
+                        "(docs/log-formats.md, \"Reference files\")")
 
 
 def _load_for_a_log(name, hours):
@@ -69,6 +75,8 @@ def cmd_simulate(args):
         say(args, f"  note: the indexing scheme of {spec.label!r} is closed loop (the firmware commands the "
                    "table); the log is written with the table fixed at its initial angle. "
                    "Use `pyins run` for closed-loop runs.")
+    if args.refs is not None and spec.refs is None:
+        raise InputError(f"--refs {args.refs}: the scenario {scn.name} has no [references] to write")
     alpha0 = float(spec.config.get("table_angle_rad", 0.0))
     sensors = sim.SensorModel(spec.errors, seed=spec.seed)
     fmt = logs.format_of(args.log, args.format)
@@ -87,6 +95,20 @@ def cmd_simulate(args):
                 bar(n, spec.duration_ticks)
     say(args, f"pyins simulate {scn.name} [{spec.label}]: {n} samples "
                f"({n * spec.dt / 3600:.3g} h) -> {args.log} ({fmt})")
-    emit_json(args, dict(log=args.log, format=fmt, samples=n, scenario=scn.name,
-                          variant=spec.label, notes=notes))
+    done = dict(log=args.log, format=fmt, samples=n, scenario=scn.name, variant=spec.label, notes=notes)
+    if args.refs is not None:
+        # whole or not at all, as the log (a temporary name renamed)
+        part = f"{args.refs}.part{os.getpid()}"
+        try:
+            references.save_refs_csv(part, spec.refs)
+            os.replace(part, args.refs)
+        except OSError as exc:
+            raise InputError(f"--refs {args.refs}: {exc.strerror or exc}") from None
+        finally:
+            if os.path.exists(part):
+                os.remove(part)
+        say(args, f"  {len(spec.refs)} references ({', '.join(sorted({references.KIND_NAMES[int(k)] for k in spec.refs['kind']}))}) "
+                   f"-> {args.refs}")
+        done["refs"] = args.refs
+    emit_json(args, done)
     return EXIT_OK

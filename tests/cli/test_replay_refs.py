@@ -96,7 +96,8 @@ def test_a_reference_file_aids_the_navigation(tmp_path, unaided):
     assert s["errors"]["speed_max_mps"] < 0.1
     assert kinds["gnss_pos"]["used"] + kinds["gnss_pos"]["rejected"] == 181
     assert s["references"]["file_span_s"] == [120.0, 300.0]
-    assert s["warnings"] == [] or all("failed the innovation gate" in w for w in s["warnings"])
+    # (a rejection or two is the gate's 0.1 % false alarms: counted, not warned about)
+    assert s["warnings"] == []
 
 
 def test_a_file_that_does_not_cover_the_log_is_warned_about_and_kept(tmp_path, capsys):
@@ -112,6 +113,23 @@ def test_a_file_that_does_not_cover_the_log_is_warned_about_and_kept(tmp_path, c
     assert s["references"]["kinds"]["gnss_pos"]["after_end"] == 4
     page = (out / "report.html").read_text()
     assert "unaided from 200 to 300 s" in page and "No warnings" not in page
+
+
+def test_references_that_do_not_fit_are_warned_about(tmp_path):
+    """Fixes 30 m off for a minute: each rejected, more than the gate's 1 in
+    1000 by chance: a warning, kept, and the fault bit (10 in a row)."""
+    refs = _fixes(np.arange(12_000, 30_001, 100), 3.0)
+    bad = (refs["kind"] == contract.REF_KINDS["gnss_pos"]) & (refs["tick"] >= 20_000) & (refs["tick"] < 26_000)
+    refs["value"][bad, 0] += 30.0 / 6.37e6                 # 30 m north
+    path = tmp_path / "off.csv"
+    R.save_refs_csv(str(path), refs)
+    rc, s, _ = _replay(tmp_path, "--refs", str(path))
+    assert rc == 0
+    k = s["references"]["kinds"]["gnss_pos"]
+    assert k["rejected"] >= 60 - 1
+    w = " | ".join(s["warnings"])
+    assert f"{k['rejected']} of the {k['used'] + k['rejected']} gnss_pos references tested failed" in w
+    assert "REF_REJECTED" in w
 
 
 def test_references_only_in_the_alignment_are_said_unused(tmp_path):
