@@ -6,8 +6,10 @@
 
 #include "angle.hpp"
 #include "attitude.hpp"
+#include "coarse_align.hpp"
 #include "config.hpp"
 #include "earth.hpp"
+#include "fine_align.hpp"
 #include "firmware.hpp"
 #include "math_portable.hpp"
 
@@ -33,8 +35,34 @@ void Firmware::start_nav_filter() {
     // on the target would reach it through the global offset table)
     const double defaults[3] = {config::kDefaultFineSigmaAtt[0], config::kDefaultFineSigmaAtt[1],
                                 config::kDefaultFineSigmaAtt[2]};
+    // After a coarse alignment alone the sigmas the configuration left 0 are
+    // fitted to the coarse result as the static fine filters' are
+    // (fine_align::sigma0_after_coarse, seed 001 sec. 2, capped at the
+    // defaults): 100', 100', 600' would let the first position fixes pull
+    // the tilt about (1.7 m/s on the shipped real log with 3 m fixes).
+    double fitted[3] = {cfg_.fine_sigma0_att_rad[0], cfg_.fine_sigma0_att_rad[1], cfg_.fine_sigma0_att_rad[2]};
+    if (fine_.states() == 0 && cfg_.coarse_ticks > 0) {
+        fine_align::Params fp{};
+        pmath::sincos(cfg_.lat_rad, &fp.sin_lat, &fp.cos_lat);
+        fp.gravity = earth::normal_gravity(fp.sin_lat, cfg_.height_m);
+        fp.gyro_arw = cfg_.fine_gyro_arw;
+        fp.accel_vrw = cfg_.fine_accel_vrw;
+        const double measured = coarse_align::measured_vrw(coarse_);
+        if (measured > fp.accel_vrw) {
+            fp.accel_vrw = measured;
+        }
+        fp.sigma0_att[0] = fitted[0];
+        fp.sigma0_att[1] = fitted[1];
+        fp.sigma0_att[2] = fitted[2];
+        fp.sigma0_gyro = cfg_.fine_sigma0_gyro;
+        fp.sigma0_accel = cfg_.fine_sigma0_accel;
+        fine_align::sigma0_after_coarse(fp, static_cast<double>(cfg_.coarse_ticks) * dt_, coarse_.wander, defaults);
+        fitted[0] = fp.sigma0_att[0];
+        fitted[1] = fp.sigma0_att[1];
+        fitted[2] = fp.sigma0_att[2];
+    }
     for (int i = 0; i < 3; ++i) {
-        const double configured = cfg_.fine_sigma0_att_rad[i] > 0.0 ? cfg_.fine_sigma0_att_rad[i] : defaults[i];
+        const double configured = fitted[i] > 0.0 ? fitted[i] : defaults[i];
         prm.sigma0_att[i] = fine_.states() != 0 ? kf_sigma[i] : configured;
     }
     prm.sigma0_vel = config::kNavSigma0Vel;

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from . import abi, attitude, config, earth, nav_filter
+from . import abi, attitude, coarse_align, config, earth, fine_align, nav_filter
 from .angle import wrap_pi
 
 REF_QUEUE = 8       #: kRefQueue
@@ -48,10 +48,25 @@ class NavAtSea:
     def start_nav_filter(self):
         cfg = self.cfg
         kf_sigma = self._kf(lambda f: np.sqrt(np.diag(f.p)))
+        # after a coarse alignment alone: the sigmas left 0 fitted to the coarse
+        # result (fine_align.sigma0_after_coarse, capped at the defaults)
+        fitted = np.array(cfg["fine_sigma0_att_rad"], dtype=float)
+        if self.kf_states == 0 and cfg["coarse_ticks"] > 0:
+            sin_lat, cos_lat = math.sin(cfg["lat_rad"]), math.cos(cfg["lat_rad"])
+            fp = fine_align.Params(
+                sin_lat=sin_lat, cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
+                dt=self.dt, meas_every=cfg["fine_meas_every_ticks"], gyro_arw=cfg["fine_gyro_arw"],
+                accel_vrw=cfg["fine_accel_vrw"], sigma0_att=fitted.copy(), sigma0_gyro=cfg["fine_sigma0_gyro"],
+                sigma0_accel=cfg["fine_sigma0_accel"], nis_window=0, nis_max=0.0)
+            measured = coarse_align.measured_vrw(self.coarse)
+            if measured > fp.accel_vrw:
+                fp.accel_vrw = measured
+            fine_align.sigma0_after_coarse(fp, float(cfg["coarse_ticks"]) * self.dt, self.coarse.wander,
+                                           config.DEFAULT_FINE_SIGMA_ATT)
+            fitted = fp.sigma0_att
         att = np.zeros(3)
         for i in range(3):
-            configured = (cfg["fine_sigma0_att_rad"][i] if cfg["fine_sigma0_att_rad"][i] > 0.0
-                          else config.DEFAULT_FINE_SIGMA_ATT[i])
+            configured = fitted[i] if fitted[i] > 0.0 else config.DEFAULT_FINE_SIGMA_ATT[i]
             att[i] = kf_sigma[i] if self.kf_states != 0 else configured
         prm = nav_filter.Params(
             dt=self.dt, every=cfg["nav_every_ticks"], reject_limit=cfg["nav_reject_limit"],
