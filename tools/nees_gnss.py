@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""Is the integrated navigation filter consistent? Its normalised
+estimation error squared (NEES) over many runs of a voyage with GNSS,
+against the chi-square 95 % bounds (the at-sea issue's acceptance 2).
+
+    .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002]
+                                        [--bias 0] [--indexing]
+
+Each run (seed s = 0 .. seeds - 1) navigates `pyins.sim.default_voyage`
+(route seed 1; the general sea state; the IMU fixed unless --indexing, then
+the firmware indexes it between two positions in the closed loop) from an
+initial state whose errors are drawn from the filter's own prior: attitude
+2', 2', 10' (E, N, U; the configured fine_sigma0_att), velocity 0.1 m/s and
+position 10 m per horizontal axis (the filter's kNavSigma0Vel and Pos).
+``--errors model`` (default): the sensor errors the filter models, drawn
+from its prior: gyro biases 0.01 deg/h, accelerometer biases 100 ug, white
+noise at the densities it assumes (0.001 deg/sqrt(h), 10 ug/sqrt(Hz)).
+``--errors seed002``: seed 002's error set instead (scale factors and
+installation errors the filter does not model), noise seeded per run.
+GNSS at 1 Hz: 3 m (5 m up) white, 0.05 m/s; ``--bias`` the receiver's
+Gauss-Markov bias [m] (300 s), which the filter does not model (0: none).
+
+NEES at each record (the record carries the filter's sigmas):
+heading (phi_U / sigma_psi)^2, chi-square with 1 degree of freedom when
+consistent; horizontal (dE^2 + dN^2) / (P_EE + P_NN), mean 1 when
+consistent (chi-square 2 / 2 when P is isotropic). Their means over the
+runs are tested against the two-sided 95 % bounds of chi-square(N) / N and
+chi-square(2N) / (2N). Printed: the share of record times after the first
+10 min inside the bounds (95 % expected), the time-averaged mean NEES and
+its bounds, at a few times.
+"""
+import argparse
+import time
+
+import numpy as np
+from scipy.stats import chi2
+
+from pyins import contract, fil, metrics, sim
+from pyins.open_loop import navigate
+from pyins.scenario.build import initial_errors
+from pyins.sim import references
+from pyins.units import ARCMIN_TO_RAD, DEG_TO_RAD, DT, G0
+
+SIGMA0_ATT = np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD     # configured: the filter's prior
+SIGMA0_VEL, SIGMA0_POS = 0.1, 10.0                            # the firmware's kNavSigma0Vel, kNavSigma0Pos
+GYRO_BIAS, ACCEL_BIAS = 0.01 * DEG_TO_RAD / 3600.0, 100e-6 * G0       # fine_sigma0_gyro, fine_sigma0_accel
+GYRO_ARW, ACCEL_VRW = 0.001 * DEG_TO_RAD / 60.0, 10e-6 * G0           # fine_gyro_arw, fine_accel_vrw
+
+
+def one_run(motion, n, seed, errors, bias, indexing):
+    rng = np.random.default_rng(1000 + seed)
+    if errors == "model":
+        z3 = np.zeros(3)
+        sens = sim.SensorErrors(gyro_bias=rng.normal(0.0, GYRO_BIAS, 3), gyro_scale=z3,
+                                gyro_misalignment=np.zeros((3, 3)), gyro_arw=GYRO_ARW, gyro_quantum=0.0,
+                                accel_bias=rng.normal(0.0, ACCEL_BIAS, 3), accel_scale=z3,
+                                accel_misalignment=np.zeros((3, 3)), accel_vrw=ACCEL_VRW, accel_quantum=0.0)
+    else:
+        sens = sim.preset("seed002")
+    phi = rng.normal(0.0, 1.0, 3) * SIGMA0_ATT
+    dv = rng.normal(0.0, SIGMA0_VEL, 2)
+    dp = rng.normal(0.0, SIGMA0_POS, 2)
+    cfg = dict(initial_errors(motion, phi=phi, velocity=[dv[0], dv[1], 0.0], north=dp[1], east=dp[0]),
+               fine_sigma0_att_rad=SIGMA0_ATT)
+    g = references.gnss(motion, n * DT, seed=2000 + seed, bias_sigma_m=bias)
+    refs = g.refs.astype(contract.REF_DTYPE)
+    if indexing:
+        res = fil.run_fil(motion, n, config=dict(cfg, index_scheme=2), errors=sens, seed=seed, every=100,
+                          refs=refs, avail_tick=g.avail_tick)
+    else:
+        res = navigate(motion, n, every=100, sensors=sim.SensorModel(sens, seed=seed), config=cfg, refs=refs,
+                       avail_tick=g.avail_tick)
+    e = metrics.nav_errors(res)
+    o = res.outputs
+    head = (e.att_n_rad[:, 2] / o["nav_sigma_heading_rad"]) ** 2
+    hor = (e.north_m ** 2 + e.east_m ** 2) / o["nav_sigma_pos_m"] ** 2
+    return e.time_s, head, hor
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=30)
+    ap.add_argument("--hours", type=float, default=2.0)
+    ap.add_argument("--errors", choices=("model", "seed002"), default="model")
+    ap.add_argument("--bias", type=float, default=0.0, help="GNSS Gauss-Markov bias sigma [m]")
+    ap.add_argument("--indexing", action="store_true", help="two-position indexing (closed loop)")
+    args = ap.parse_args()
+    motion = sim.default_voyage(args.hours, seed=1)
+    n = int(round(args.hours * 3600.0 / DT))
+    t0 = time.perf_counter()
+    heads, hors = [], []
+    for s in range(args.seeds):
+        t, h, p = one_run(motion, n, s, args.errors, args.bias, args.indexing)
+        heads.append(h)
+        hors.append(p)
+        print(f"  run {s + 1}/{args.seeds}: mean NEES heading {h[t >= 600].mean():.2f}, horizontal "
+              f"{p[t >= 600].mean():.2f} ({time.perf_counter() - t0:.0f} s)", flush=True)
+    head, hor = np.mean(heads, axis=0), np.mean(hors, axis=0)
+    N = args.seeds
+    b1 = (chi2.ppf(0.025, N) / N, chi2.ppf(0.975, N) / N)
+    b2 = (chi2.ppf(0.025, 2 * N) / (2 * N), chi2.ppf(0.975, 2 * N) / (2 * N))
+    late = t >= 600.0
+    print(f"\nvoyage {args.hours:g} h, {N} runs, errors {args.errors}, GNSS bias {args.bias:g} m, "
+          f"{'two-position indexing' if args.indexing else 'IMU fixed'}")
+    for name, v, (lo, hi) in (("heading", head, b1), ("horizontal", hor, b2)):
+        inside = np.mean((v[late] >= lo) & (v[late] <= hi))
+        print(f"{name:10s} mean NEES over the runs: time average {v[late].mean():.3f} (bounds {lo:.3f} .. "
+              f"{hi:.3f}); inside at {100 * inside:.1f} % of the record times after 10 min")
+        for ts in (600, 1800, 3600, int(args.hours * 3600) - 1):
+            k = int(np.searchsorted(t, ts))
+            if k < len(t):
+                print(f"           at {t[k]:6.0f} s: {v[k]:.3f}")
+
+
+if __name__ == "__main__":
+    main()
