@@ -157,7 +157,7 @@ _STATUS_MEANING = {
                           "nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks "
                           "1..10 s (0 = default)",
     "PYINS_E_REF_KIND": "unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, "
-                        "ZERO_VEL are used)",
+                        "SPEED_LOG, ZERO_VEL are used)",
     "PYINS_E_REF_VALUE": "a reference value is not finite (or a latitude beyond 90 deg), or its sigma is "
                          "not finite and > 0; refused, state unchanged",
     "PYINS_E_REF_ORDER": "a reference older than the last one pushed, or older than ref_max_latency_ticks "

@@ -195,6 +195,9 @@ enum pyins_nav_mode {
                                      the filter's covariance running throughout */
     PYINS_NAV_UNDAMPED = 1,       /* free inertial navigation (the firmware of ABI 0.14): no filter,
                                      references refused (PYINS_E_REF_UNUSED) */
+    PYINS_NAV_DAMPED = 2,         /* reported only (AUTO, INTEGRATED): the speed log the only reference
+                                     in use, on a straight course: the horizontal channels damped by
+                                     it; the position is dead reckoning */
     PYINS_NAV_INTEGRATED = 3      /* the error-state Kalman filter corrects attitude, velocity,
                                      position and the IMU biases from the references */
 };
@@ -206,7 +209,8 @@ enum pyins_ref_kind {
     PYINS_REF_GNSS_POS = 1,       /* value: [lat rad, lon rad, height m]; sigma: [E, N, U] m (U unused:
                                      the vertical channel is held) */
     PYINS_REF_GNSS_VEL = 2,       /* value: ENU velocity m/s; sigma: per axis m/s (U unused) */
-    PYINS_REF_SPEED_LOG = 3,      /* reserved: EM log speed through water (refused in ABI 0.15) */
+    PYINS_REF_SPEED_LOG = 3,      /* EM log: value[0] speed through water along the bow [m/s]; sigma[0]
+                                     [m/s] (components 1, 2 not used): damps the horizontal channels */
     PYINS_REF_DVL = 4,            /* reserved: DVL velocity (refused in ABI 0.15) */
     PYINS_REF_ZERO_VEL = 5        /* the ship at rest: value 0; sigma: per axis m/s (U unused) */
 };

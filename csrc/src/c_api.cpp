@@ -448,7 +448,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or PYINS_COARSE_EQ8";
         case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
         case PYINS_E_CONFIG_NAV: return "PYINS_E_CONFIG_NAV: nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks 1..10 s (0 = default)";
-        case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, ZERO_VEL are used)";
+        case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, SPEED_LOG, ZERO_VEL are used)";
         case PYINS_E_REF_VALUE: return "PYINS_E_REF_VALUE: a reference value is not finite (or a latitude beyond 90 deg), or its sigma is not finite and > 0; refused, state unchanged";
         case PYINS_E_REF_ORDER: return "PYINS_E_REF_ORDER: a reference older than the last one pushed, or older than ref_max_latency_ticks before the current tick; refused, state unchanged";
         case PYINS_E_REF_FUTURE: return "PYINS_E_REF_FUTURE: a reference more than 10 s ahead of the current tick; refused, state unchanged";

@@ -90,6 +90,18 @@ void Firmware::init(const pyins_config& raw) {
         ref_seen_vel_[i][1] = 0.0;
     }
     reserved_ref_ = 0;
+    log_speed_ = 0.0;
+    current_n_[0] = 0.0;
+    current_n_[1] = 0.0;
+    bow_last_[0] = 0.0;
+    bow_last_[1] = 0.0;
+    turn_rate_f_ = 0.0;
+    damp_int_[0] = 0.0;
+    damp_int_[1] = 0.0;
+    current_known_ = 0;
+    straight_s_ = 0;
+    bow_known_ = 0;
+    damp_on_ = 0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
     coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 

@@ -38,6 +38,29 @@ inline constexpr int32_t kRefQueue = 8;
 inline constexpr int32_t kRefKinds = 5;
 /// A kind is in use while one of its references was applied within this [s].
 inline constexpr int32_t kRefInUseS = 10;
+/// Level damping by the speed log (docs/concepts.md, "At sea"): a
+/// third-order network on each horizontal channel whose closed loop has the
+/// poles (s + w_s)(s^2 + 2 zeta w_s s + w_s^2), w_s = sqrt(g / R) the
+/// 84.4-min Schuler frequency: the Schuler period kept, its damping ratio
+/// zeta, a real pole as fast, and no steady velocity error from a constant
+/// gyro drift (damp_interval gives the gains).
+inline constexpr double kDampingRatio = 0.707;
+/// The course is straight while the bow's turn rate, low-passed with this
+/// time constant [s], stays under kStraightRate [rad/s] (0.3 deg/s: a
+/// ship's course change is 0.5-1 deg/s; the sea's yaw swing, ~1 deg/s at
+/// ~0.1 Hz, is attenuated ~13x by the low-pass); damping waits kStraightS
+/// seconds of it.
+inline constexpr double kTurnTau = 20.0;
+inline constexpr double kStraightRate = 0.3 * kPi / 180.0;
+inline constexpr int32_t kStraightS = 10;
+/// The current (and the ship's mean sideslip, the yaw swing's bias) is the
+/// mean of v - v_log b over the first kCurrentReadings log readings used
+/// (the velocity then is the alignment's or the references'), then, while
+/// the velocity is known (GNSS velocity or zero velocity in use), a
+/// first-order low-pass over as many readings; held otherwise. Damping
+/// waits for the mean: one reading would carry the yaw swing of the moment
+/// (a few degrees at 8 m/s is 0.5 m/s across the bow).
+inline constexpr int32_t kCurrentReadings = 60;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -200,6 +223,15 @@ class Firmware {
     nav_filter::Motion nav_motion() const;
     /// Navigation filter work of a NAVIGATE tick, after the strapdown.
     void nav_tick(const Vec3& dv_sf_n);
+    /// Once a filter interval in NAVIGATE: the course's turn rate and, in
+    /// DAMPED, the level damping of the horizontal velocity by the log.
+    void damp_interval();
+    /// The bow's horizontal direction in n (E, N; unit), from C_b^n's column 1.
+    void bow_n(double* east, double* north) const;
+    /// The reference point's velocity (E, N) [m/s] (the navigated point's
+    /// without a lever arm).
+    void ref_point_vel(double* east, double* north) const;
+    void apply_log(const pyins_ref& ref, int32_t slot);
     /// Apply the references whose tick has come (tick_ just advanced).
     void refs_due();
     /// Gate and apply one reference now (lag: ticks since its tick).
@@ -271,6 +303,16 @@ class Firmware {
     int64_t ref_seen_tick_[kRefKinds];    ///< its tick
     double ref_seen_value_[kRefKinds][2]; ///< its value[0], value[1]
     double ref_seen_vel_[kRefKinds][2];   ///< the reference point's velocity then (E, N) [m/s]
+    // Level damping by the speed log (damp_interval, apply_log).
+    double log_speed_;            ///< the last log reading used [m/s] (speed through water, bow)
+    double current_n_[2];         ///< the water current learnt, v - v_log bow (E, N) [m/s]
+    double bow_last_[2];          ///< the bow's direction at the last interval (E, N)
+    double turn_rate_f_;          ///< the bow's turn rate, low-passed [rad/s]
+    double damp_int_[2];          ///< the network's integrators, K3 int (v - v_ref) (E, N) [m/s]
+    int32_t current_known_;       ///< log readings in current_n_'s mean (saturates at kCurrentReadings)
+    int32_t straight_s_;          ///< seconds of straight course (saturates at kStraightS)
+    int32_t bow_known_;           ///< 1: bow_last_ holds a value
+    int32_t damp_on_;             ///< 1: the last interval damped
 };
 
 }  // namespace pyins::firmware

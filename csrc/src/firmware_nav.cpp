@@ -91,6 +91,7 @@ void Firmware::nav_tick(const Vec3& dv_sf_n) {
         if (nav_.healthy == 0) {
             faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
         }
+        damp_interval();
     }
 }
 
@@ -98,13 +99,16 @@ int Firmware::push_ref(const pyins_ref& ref) {
     if (cfg_.nav_mode == PYINS_NAV_UNDAMPED) {
         return PYINS_E_REF_UNUSED;
     }
-    if (ref.kind != PYINS_REF_GNSS_POS && ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_ZERO_VEL) {
+    if (ref.kind != PYINS_REF_GNSS_POS && ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_ZERO_VEL &&
+        ref.kind != PYINS_REF_SPEED_LOG) {
         return PYINS_E_REF_KIND;
     }
-    // the vertical is held: sigma[2] is not used, nor checked
+    // the vertical is held: sigma[2] is not used, nor checked; the log uses
+    // component 0 alone
+    const bool log = ref.kind == PYINS_REF_SPEED_LOG;
     if (!std::isfinite(ref.value[0]) || !std::isfinite(ref.value[1]) || !std::isfinite(ref.value[2]) ||
-        !(ref.sigma[0] > 0.0) || !(ref.sigma[1] > 0.0) || !std::isfinite(ref.sigma[0]) ||
-        !std::isfinite(ref.sigma[1]) ||
+        !(ref.sigma[0] > 0.0) || !std::isfinite(ref.sigma[0]) ||
+        (!log && (!(ref.sigma[1] > 0.0) || !std::isfinite(ref.sigma[1]))) ||
         (ref.kind == PYINS_REF_GNSS_POS && !(std::fabs(ref.value[0]) <= 0.5 * kPi))) {
         return PYINS_E_REF_VALUE;
     }
@@ -148,8 +152,155 @@ void Firmware::refs_due() {
     }
 }
 
+void Firmware::bow_n(double* east, double* north) const {
+    // C_b^n = C_p^n C_b^p; its column 1 (the bow) is (C01, C11, C21)
+    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+    const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
+    const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
+    const double h = pmath::sqrt(c01 * c01 + c11 * c11);
+    *east = 0.0;    // (a vertical bow: no horizontal direction)
+    *north = 0.0;
+    if (h > 0.0) {
+        *east = c01 / h;
+        *north = c11 / h;
+    }
+}
+
+void Firmware::ref_point_vel(double* east, double* north) const {
+    Vec3 vel = sd_.nav.vel_n;
+    if (has_lever_ != 0) {
+        double lat;
+        double lon;
+        double height;
+        reference_point(&lat, &lon, &height, &vel);
+    }
+    *east = vel(0);
+    *north = vel(1);
+}
+
+void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
+    // The EM log: speed through water along the bow, v_log. A damping
+    // reference, not a filter measurement: the ground velocity it stands for
+    // is v_log b + c, b the bow's horizontal direction, c the current (and
+    // the ship's sideslip) learnt where the velocity is known.
+    double be;
+    double bn;
+    bow_n(&be, &bn);
+    double ve;
+    double vn;
+    ref_point_vel(&ve, &vn);
+    const double v_log = ref.value[0];
+    if (current_known_ == 0) {
+        // the first reading: the velocity now stands for the current (the
+        // gate's reference until the mean is made)
+        current_n_[0] = ve - v_log * be;
+        current_n_[1] = vn - v_log * bn;
+    }
+    // gate: the innovation along the bow against the log's sigma and the
+    // filter's velocity variance there (chi-square, 1 degree of freedom,
+    // tested against nav_gate)
+    const double innov = (ve - current_n_[0]) * be + (vn - current_n_[1]) * bn - v_log;
+    const int32_t kv = nav_filter::kVel;
+    const double pvv = nav_.p(kv, kv) * be * be + 2.0 * nav_.p(kv, kv + 1) * be * bn + nav_.p(kv + 1, kv + 1) * bn * bn;
+    const double nis = innov * innov / (ref.sigma[0] * ref.sigma[0] + pvv);
+    nav_nis_[slot] = nis;
+    if (!(nis <= cfg_.nav_gate)) {   // a NaN fails too
+        count(&n_ref_rejected_[slot], 1u);
+        if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
+            ref_reject_run_[slot] = ref_reject_run_[slot] + 1;
+        }
+        if (ref_reject_run_[slot] == cfg_.nav_reject_limit) {
+            ref_out_[slot] = 1;
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_REF_REJECTED);
+        }
+        return;
+    }
+    ref_reject_run_[slot] = 0;
+    ref_out_[slot] = 0;
+    count(&n_ref_used_[slot], 1u);
+    ref_used_tick_[slot] = tick_;
+    log_speed_ = v_log;
+    // the current: the mean of the first kCurrentReadings readings, then a
+    // low-pass while the velocity is known (GNSS velocity or zero velocity
+    // in use), else held (firmware.hpp)
+    const uint32_t known = (1u << (PYINS_REF_GNSS_VEL - 1)) | (1u << (PYINS_REF_ZERO_VEL - 1));
+    double n = static_cast<double>(kCurrentReadings);
+    if (current_known_ < kCurrentReadings) {
+        current_known_ = current_known_ + 1;
+        n = static_cast<double>(current_known_);
+    } else if ((refs_in_use() & known) == 0u) {
+        return;
+    }
+    current_n_[0] = current_n_[0] + (ve - v_log * be - current_n_[0]) / n;
+    current_n_[1] = current_n_[1] + (vn - v_log * bn - current_n_[1]) / n;
+}
+
+void Firmware::damp_interval() {
+    const double t = static_cast<double>(nav_.prm.every) * dt_;
+    double be;
+    double bn;
+    bow_n(&be, &bn);
+    // the course's turn rate: the bow's rotation over the interval (its sine),
+    // low-passed over kTurnTau
+    if (bow_known_ != 0) {
+        const double rate = (bow_last_[1] * be - bow_last_[0] * bn) / t;
+        turn_rate_f_ = turn_rate_f_ + (rate - turn_rate_f_) * (t / kTurnTau);
+    }
+    bow_last_[0] = be;
+    bow_last_[1] = bn;
+    bow_known_ = 1;
+    if (std::fabs(turn_rate_f_) < kStraightRate) {
+        if (straight_s_ < kStraightS) {
+            straight_s_ = straight_s_ + 1;
+        }
+    } else {
+        straight_s_ = 0;
+    }
+    damp_on_ = nav_mode_now() == PYINS_NAV_DAMPED ? 1 : 0;
+    if (damp_on_ == 0) {
+        return;
+    }
+    // Level damping: a third-order network on each horizontal channel
+    // (the classic marine damping of the Schuler loop; Qin 2014, ch. 5;
+    // Titterton & Weston 2004, sec. 12.3). With e = v - v_ref, the north
+    // channel's errors (ENU, Qin 2014 eq. 4.2.15: dv_N' = g phi_E,
+    // phi_E' = -dv_N / R + eps_E) gain
+    //   dv_N'  -= K1 e_N
+    //   phi_E' -= (K2 e_N + K3 int e_N) / R
+    // (the east channel alike, phi_N' += ...), so that
+    //   s^3 + K1 s^2 + w_s^2 (1 + K2) s + w_s^2 K3
+    //     = (s + w_s)(s^2 + 2 zeta w_s s + w_s^2):
+    //   K1 = (1 + 2 zeta) w_s,  K2 = 2 zeta,  K3 = w_s,
+    // and a constant gyro drift leaves no steady velocity error (the
+    // integrator holds R eps). Applied once an interval t: the velocity
+    // less K1 t e, the attitude turned by the phi change (C <- (I - dphi x) C:
+    // the rotation by -dphi), the integrators plus K3 t e.
+    const nav_filter::Motion m = nav_motion();
+    const double g = earth::normal_gravity(m.sin_lat, sd_.nav.height);
+    const double w_s = pmath::sqrt(g / pmath::sqrt(m.rm_h * m.rn_h));
+    const double k1 = (1.0 + 2.0 * kDampingRatio) * w_s;
+    const double k2 = 2.0 * kDampingRatio;
+    const double k3 = w_s;
+    double ve;
+    double vn;
+    ref_point_vel(&ve, &vn);
+    const double e_e = ve - (log_speed_ * be + current_n_[0]);
+    const double e_n = vn - (log_speed_ * bn + current_n_[1]);
+    damp_int_[0] = damp_int_[0] + k3 * t * e_e;
+    damp_int_[1] = damp_int_[1] + k3 * t * e_n;
+    const Vec3 dphi(-(k2 * e_n + damp_int_[1]) * t / m.rm_h, (k2 * e_e + damp_int_[0]) * t / m.rn_h, 0.0);
+    strapdown::NavState& nav = sd_.nav;
+    nav.quat_np = attitude::quat_normalize(attitude::quat_mul(attitude::rotvec_to_quat(-dphi), nav.quat_np));
+    nav.vel_n(0) = nav.vel_n(0) - k1 * t * e_e;
+    nav.vel_n(1) = nav.vel_n(1) - k1 * t * e_n;
+}
+
 void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     const int32_t slot = ref.kind - 1;
+    if (ref.kind == PYINS_REF_SPEED_LOG) {
+        apply_log(ref, slot);
+        return;
+    }
     const nav_filter::Motion m = nav_motion();
     // the time update up to this tick first
     nav_filter::predict(nav_, m, attitude::quat_to_mat(sd_.nav.quat_np));
@@ -254,8 +405,16 @@ int32_t Firmware::nav_mode_now() const {
     if (mode_ != Mode::kNavigate) {
         return 0;
     }
-    return nav_on_ != 0 && refs_in_use() != 0u ? static_cast<int32_t>(PYINS_NAV_INTEGRATED)
-                                                : static_cast<int32_t>(PYINS_NAV_UNDAMPED);
+    const uint32_t in_use = nav_on_ != 0 ? refs_in_use() : 0u;
+    const uint32_t log = 1u << (PYINS_REF_SPEED_LOG - 1);
+    if ((in_use & ~log) != 0u) {
+        return static_cast<int32_t>(PYINS_NAV_INTEGRATED);
+    }
+    // the log alone, on a straight course: damped (the position is dead reckoning)
+    if ((in_use & log) != 0u && straight_s_ >= kStraightS && current_known_ >= kCurrentReadings) {
+        return static_cast<int32_t>(PYINS_NAV_DAMPED);
+    }
+    return static_cast<int32_t>(PYINS_NAV_UNDAMPED);
 }
 
 uint32_t Firmware::refs_in_use() const {

@@ -77,8 +77,8 @@ def add_replay(cmd):
                         "t, lat_deg, lon_deg [, height_m, heading_deg], t on the log's clock "
                         "(docs/cli.md, \"pyins replay\")")
     p.add_argument("--refs", metavar="FILE",
-                   help="external references used in navigation (GNSS position and velocity, zero "
-                        "velocity), ticks on the log's clock (tick T: the end of its T-th sample): the text layout "
+                   help="external references used in navigation (GNSS position and velocity, EM speed "
+                        "log, zero velocity), ticks on the log's clock (tick T: the end of its T-th sample): the text layout "
                         "'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, \"Reference files\")")
     p.add_argument("--zero-velocity", nargs="?", const="0.01 m/s", metavar="SIGMA",
                    help="the vehicle or ship at rest after its alignment: a zero-velocity reference every "
@@ -222,10 +222,10 @@ def _feed(args, cfg, hz):
         if not len(refs):
             raise InputError(f"--refs {args.refs}: holds no reference (only its header)")
         unused = sorted({reference_files.KIND_NAMES[int(k)] for k in refs["kind"]}
-                        - {"gnss_pos", "gnss_vel", "zero_velocity"})
+                        - {"gnss_pos", "gnss_vel", "speed_log", "zero_velocity"})
         if unused:
             raise InputError(f"--refs {args.refs}: {', '.join(unused)} references are not used by this "
-                             "firmware yet (it takes gnss_pos, gnss_vel and zero_velocity)")
+                             "firmware yet (it takes gnss_pos, gnss_vel, speed_log and zero_velocity)")
     if args.zero_velocity is not None:
         zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
         if not (np.isfinite(zv) and zv > 0.0):

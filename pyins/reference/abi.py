@@ -111,6 +111,7 @@ PYINS_FAULT_REF_REJECTED = 1024
 # --- enum pyins_nav_mode ----------------------------------------------------
 PYINS_NAV_AUTO = 0
 PYINS_NAV_UNDAMPED = 1
+PYINS_NAV_DAMPED = 2
 PYINS_NAV_INTEGRATED = 3
 
 # --- enum pyins_ref_kind ----------------------------------------------------
@@ -157,7 +158,7 @@ ENUMS = {
         ("pyins_fault_flag", [n for n in dir() if n.startswith("PYINS_FAULT_")]),
         ("pyins_seq_mode", ["PYINS_SEQ_OFF", "PYINS_SEQ_CHECK"]),
         ("pyins_mode", [n for n in dir() if n.startswith("PYINS_MODE_")]),
-        ("pyins_nav_mode", ["PYINS_NAV_AUTO", "PYINS_NAV_UNDAMPED", "PYINS_NAV_INTEGRATED"]),
+        ("pyins_nav_mode", ["PYINS_NAV_AUTO", "PYINS_NAV_UNDAMPED", "PYINS_NAV_DAMPED", "PYINS_NAV_INTEGRATED"]),
         ("pyins_ref_kind", [n for n in dir() if n.startswith("PYINS_REF_")]),
         ("pyins_state_flag", ["PYINS_STATE_ATT_VALID", "PYINS_STATE_POS_AIDED"]),
         ("pyins_vertical_mode", ["PYINS_VERTICAL_HOLD", "PYINS_VERTICAL_FREE"]),

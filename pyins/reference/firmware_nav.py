@@ -15,6 +15,11 @@ from .angle import wrap_pi
 REF_QUEUE = 8       #: kRefQueue
 REF_KINDS = 5       #: kRefKinds
 REF_IN_USE_S = 10   #: kRefInUseS
+DAMPING_RATIO = 0.707                   #: kDampingRatio
+TURN_TAU = 20.0                         #: kTurnTau [s]
+STRAIGHT_RATE = 0.3 * math.pi / 180.0   #: kStraightRate [rad/s]
+STRAIGHT_S = 10                         #: kStraightS
+CURRENT_READINGS = 60                   #: kCurrentReadings
 U32 = 0xFFFFFFFF
 
 
@@ -44,6 +49,16 @@ class NavAtSea:
         self.ref_seen_tick = [-1] * REF_KINDS
         self.ref_seen_value = [(0.0, 0.0)] * REF_KINDS
         self.ref_seen_vel = [(0.0, 0.0)] * REF_KINDS
+        # level damping by the speed log (damp_interval, apply_log)
+        self.log_speed = 0.0
+        self.current_n = [0.0, 0.0]
+        self.bow_last = [0.0, 0.0]
+        self.turn_rate_f = 0.0
+        self.damp_int = [0.0, 0.0]
+        self.current_known = 0
+        self.straight_s = 0
+        self.bow_known = 0
+        self.damp_on = 0
 
     def start_nav_filter(self):
         cfg = self.cfg
@@ -89,18 +104,108 @@ class NavAtSea:
             nav_filter.predict(self.nav, self.nav_motion(), attitude.quat_to_mat(self.sd.nav.quat_np))
             if self.nav.healthy == 0:
                 self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
+            self.damp_interval()
+
+    def bow_n(self):
+        """The bow's horizontal direction in n (E, N; unit): C_b^n's column 1."""
+        w, x, y, z = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+        c01 = 2.0 * (x * y - w * z)
+        c11 = w * w - x * x + y * y - z * z
+        h = math.sqrt(c01 * c01 + c11 * c11)
+        if h > 0.0:
+            return c01 / h, c11 / h
+        return 0.0, 0.0
+
+    def ref_point_vel(self):
+        vel = self.sd.nav.vel_n
+        if self.has_lever:
+            vel = self.reference_point()[3]
+        return float(vel[0]), float(vel[1])
+
+    def apply_log(self, value, sigma, slot):
+        """The EM log: a damping reference, not a filter measurement (mirrors apply_log)."""
+        be, bn = self.bow_n()
+        ve, vn = self.ref_point_vel()
+        v_log = value[0]
+        if self.current_known == 0:
+            self.current_n = [ve - v_log * be, vn - v_log * bn]
+        innov = (ve - self.current_n[0]) * be + (vn - self.current_n[1]) * bn - v_log
+        p = self.nav.p
+        kv = nav_filter.VEL
+        pvv = p[kv, kv] * be * be + 2.0 * p[kv, kv + 1] * be * bn + p[kv + 1, kv + 1] * bn * bn
+        nis = innov * innov / (sigma[0] * sigma[0] + pvv)
+        self.nav_nis[slot] = nis
+        if not nis <= self.cfg["nav_gate"]:
+            self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
+            if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
+                self.ref_reject_run[slot] += 1
+            if self.ref_reject_run[slot] == self.cfg["nav_reject_limit"]:
+                self.ref_out[slot] = 1
+                self.faults = self.faults | abi.PYINS_FAULT_REF_REJECTED
+            return
+        self.ref_reject_run[slot] = 0
+        self.ref_out[slot] = 0
+        self.n_ref_used[slot] = count(self.n_ref_used[slot])
+        self.ref_used_tick[slot] = self.tick
+        self.log_speed = v_log
+        known = (1 << (abi.PYINS_REF_GNSS_VEL - 1)) | (1 << (abi.PYINS_REF_ZERO_VEL - 1))
+        n = float(CURRENT_READINGS)
+        if self.current_known < CURRENT_READINGS:
+            self.current_known += 1
+            n = float(self.current_known)
+        elif not self.refs_in_use() & known:
+            return
+        self.current_n = [self.current_n[0] + (ve - v_log * be - self.current_n[0]) / n,
+                          self.current_n[1] + (vn - v_log * bn - self.current_n[1]) / n]
+
+    def damp_interval(self):
+        """The course's turn rate and, in DAMPED, the level damping (mirrors damp_interval)."""
+        t = float(self.nav.prm.every) * self.dt
+        be, bn = self.bow_n()
+        if self.bow_known:
+            rate = (self.bow_last[1] * be - self.bow_last[0] * bn) / t
+            self.turn_rate_f = self.turn_rate_f + (rate - self.turn_rate_f) * (t / TURN_TAU)
+        self.bow_last = [be, bn]
+        self.bow_known = 1
+        if abs(self.turn_rate_f) < STRAIGHT_RATE:
+            if self.straight_s < STRAIGHT_S:
+                self.straight_s += 1
+        else:
+            self.straight_s = 0
+        self.damp_on = 1 if self.nav_mode_now() == abi.PYINS_NAV_DAMPED else 0
+        if not self.damp_on:
+            return
+        # level damping: the third-order network (firmware_nav.cpp gives the gains)
+        m = self.nav_motion()
+        g = earth.normal_gravity(m.sin_lat, self.sd.nav.height)
+        w_s = math.sqrt(g / math.sqrt(m.rm_h * m.rn_h))
+        k1 = (1.0 + 2.0 * DAMPING_RATIO) * w_s
+        k2 = 2.0 * DAMPING_RATIO
+        k3 = w_s
+        ve, vn = self.ref_point_vel()
+        e_e = ve - (self.log_speed * be + self.current_n[0])
+        e_n = vn - (self.log_speed * bn + self.current_n[1])
+        self.damp_int = [self.damp_int[0] + k3 * t * e_e, self.damp_int[1] + k3 * t * e_n]
+        dphi = np.array([-(k2 * e_n + self.damp_int[1]) * t / m.rm_h, (k2 * e_e + self.damp_int[0]) * t / m.rn_h,
+                         0.0])
+        nav = self.sd.nav
+        nav.quat_np = attitude.quat_normalize(attitude.quat_mul(attitude.rotvec_to_quat(-dphi), nav.quat_np))
+        nav.vel_n[0] = nav.vel_n[0] - k1 * t * e_e
+        nav.vel_n[1] = nav.vel_n[1] - k1 * t * e_n
 
     def push_ref(self, kind, tick, value, sigma):
         """One reference; PYINS_OK or a PYINS_E_REF_* status (mirrors push_ref)."""
         cfg = self.cfg
         if cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED:
             return abi.PYINS_E_REF_UNUSED
-        if kind not in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_ZERO_VEL):
+        if kind not in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_ZERO_VEL,
+                        abi.PYINS_REF_SPEED_LOG):
             return abi.PYINS_E_REF_KIND
         value = [float(v) for v in value]
         sigma = [float(s) for s in sigma]
-        if (not all(math.isfinite(v) for v in value) or not (sigma[0] > 0.0) or not (sigma[1] > 0.0)
-                or not math.isfinite(sigma[0]) or not math.isfinite(sigma[1])
+        log = kind == abi.PYINS_REF_SPEED_LOG
+        if (not all(math.isfinite(v) for v in value) or not (sigma[0] > 0.0) or not math.isfinite(sigma[0])
+                or (not log and (not (sigma[1] > 0.0) or not math.isfinite(sigma[1])))
                 or (kind == abi.PYINS_REF_GNSS_POS and not abs(value[0]) <= 0.5 * math.pi)):
             return abi.PYINS_E_REF_VALUE
         if tick < self.ref_last_tick or tick < self.tick - cfg["ref_max_latency_ticks"]:
@@ -132,6 +237,9 @@ class NavAtSea:
     def apply_ref(self, ref, lag):
         kind, _, value, sigma = ref
         slot = kind - 1
+        if kind == abi.PYINS_REF_SPEED_LOG:
+            self.apply_log(value, sigma, slot)
+            return
         m = self.nav_motion()
         nav_filter.predict(self.nav, m, attitude.quat_to_mat(self.sd.nav.quat_np))
         nav = self.sd.nav
@@ -203,7 +311,13 @@ class NavAtSea:
     def nav_mode_now(self):
         if self.mode != abi.PYINS_MODE_NAVIGATE:
             return 0
-        return abi.PYINS_NAV_INTEGRATED if self.nav_on and self.refs_in_use() else abi.PYINS_NAV_UNDAMPED
+        in_use = self.refs_in_use() if self.nav_on else 0
+        log = 1 << (abi.PYINS_REF_SPEED_LOG - 1)
+        if in_use & ~log:
+            return abi.PYINS_NAV_INTEGRATED
+        if in_use & log and self.straight_s >= STRAIGHT_S and self.current_known >= CURRENT_READINGS:
+            return abi.PYINS_NAV_DAMPED
+        return abi.PYINS_NAV_UNDAMPED
 
     def refs_in_use(self):
         window = REF_IN_USE_S * self.cfg["tick_hz"]

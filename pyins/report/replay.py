@@ -208,11 +208,12 @@ def plot_references(nav, hz, kinds, gate, path):
     t, tl = time_axis(nav["tick"] / hz)
     fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     slots = {name: abi_kind - 1 for name, abi_kind in kinds.items()}
-    rows = [("integrated", (nav["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float))]
+    rows = [("integrated", (nav["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float)),
+            ("damped (log)", (nav["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
     rows += [(f"{name} in use", ((nav["ref_in_use"] >> s) & 1).astype(float))
              for name, s in sorted(slots.items(), key=lambda kv: kv[1])]
     for j, (label, on) in enumerate(rows):      # one lane each: up while on
-        ax[0].step(t, on * 0.6 + j, where="post", lw=1.2, color="k" if j == 0 else f"C{j - 1}")
+        ax[0].step(t, on * 0.6 + j, where="post", lw=1.2, color="k" if j < 2 else f"C{j - 2}")
     ax[0].set_yticks([j + 0.3 for j in range(len(rows))], [label for label, _ in rows], fontsize=8)
     ax[0].set_ylim(-0.3, len(rows))
     for name, s in sorted(slots.items(), key=lambda kv: kv[1]):

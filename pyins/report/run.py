@@ -293,10 +293,11 @@ def plot_references(summary, series, path):
                 ax[1, j].semilogy(t[ok], nis[ok], ".", ms=1.5, label=f"{names[k]} NIS")
         ax[1, j].axhline(gate, color="r", lw=0.8, ls="--", label=f"gate {gate:.4g}")
         ax[1, j].set_ylabel("normalised innovation (last)")
-        lanes = [("integrated", (o["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float))]
+        lanes = [("integrated", (o["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float)),
+                 ("damped (log)", (o["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
         lanes += [(f"{names[k]} in use", ((o["ref_in_use"] >> k) & 1).astype(float)) for k in kinds]
         for i, (name, on) in enumerate(lanes):
-            ax[2, j].step(t, on * 0.6 + i, where="post", lw=1.0, color="k" if i == 0 else f"C{i - 1}")
+            ax[2, j].step(t, on * 0.6 + i, where="post", lw=1.0, color="k" if i < 2 else f"C{i - 2}")
         ax[2, j].set_yticks([i + 0.3 for i in range(len(lanes))], [n for n, _ in lanes], fontsize=8)
         ax[2, j].set_ylim(-0.3, len(lanes))
         ax[2, j].set_xlabel(tl)

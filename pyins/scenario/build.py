@@ -329,6 +329,15 @@ def _references(res, motion):
                                      bias_tau_s=g["bias_tau_s"], latency_s=g["latency_s"], outages=outages,
                                      outlier_rate=g["outlier_rate"], frozen=[tuple(w) for w in g["frozen"]],
                                      seed=g["seed"], velocity=g["velocity"]))
+    lg = rt.get("speed_log")
+    if lg is not None:
+        current = references.Current(mean_enu=lg["current_mps"], amplitude_mps=lg["current_tide_mps"],
+                                     seed=lg["seed"])
+        log = references.speed_log(motion, duration, current, rate_hz=lg["rate_hz"],
+                                   scale_factor=lg["scale_factor"], bias_mps=lg["bias_mps"],
+                                   noise_mps=lg["noise_mps"], seed=lg["seed"], dt=DT)
+        log.refs["sigma"][:, 0] = lg["sigma_mps"]      # what the firmware is told
+        parts.append(log)
     z = rt.get("zero_velocity")
     if z is not None:
         fw = res["firmware"]

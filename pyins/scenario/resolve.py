@@ -308,6 +308,9 @@ def _resolve_references(table, duration_s, firmware):
             if abs(step - round(step)) > 1e-6 or round(step) < 1:
                 raise ScenarioError(f"{v[rate_key]:g} Hz: 1 / rate must be a whole number of ticks "
                                     f"({DT:g} s)", f"{path}.{rate_key}")
+        if name == "speed_log" and v["current"][2] != 0.0:
+            raise ScenarioError("the current is horizontal: give [E, N, 0] (its up component must be 0)",
+                                f"{path}.current")
         if name == "gnss":
             v["outages"] = _windows(v["outages"], f"{path}.outages", duration_s)
             v["frozen"] = _windows(v["frozen"], f"{path}.frozen", duration_s)

@@ -382,8 +382,24 @@ ZERO_VELOCITY_KEYS = {
     "sigma": Key("velocity", "sigma per axis", "0.01 m/s", lo="0 m/s", hi="10 m/s", lo_open=True),
     "start": _time("the first declaration after ... (default: the end of the alignment)", None),
 }
+#: Keys of [references.speed_log]: an EM log (pyins.sim.references.speed_log)
+#: in a water current, the firmware's damping reference.
+SPEED_LOG_KEYS = {
+    "rate": Key("frequency", "readings per second (1 / rate a whole number of ticks)", "1 Hz", lo="0 Hz",
+                hi="100 Hz", lo_open=True),
+    "noise": Key("velocity", "white noise of a reading", "0.05 m/s", lo="0 m/s", hi="10 m/s"),
+    "scale_factor": Key("dimensionless", "scale factor error", 0.005, lo=-0.5, hi=0.5),
+    "bias": Key("velocity", "bias of a reading", "0 m/s", lo="-10 m/s", hi="10 m/s"),
+    "sigma": Key("velocity", "the sigma the firmware is told (noise, scale factor and what else the "
+                             "reading misses)", "0.1 m/s", lo="0 m/s", hi="10 m/s", lo_open=True),
+    "current": Key("velocity", "the water current's mean, [E, N, 0]", "0 m/s", lo="-10 m/s",
+                   hi="10 m/s", shape=3),
+    "current_tide": Key("velocity", "a tidal ellipse on top, at the M2 period (12.42 h), amplitude per axis",
+                        "0 m/s", lo="0 m/s", hi="10 m/s"),
+    "seed": Key("int", "seed of the log's noise and the tide's phases (not the IMU's)", default=0, lo=0),
+}
 #: [references] sub-tables -> their keys
-REFERENCE_TABLES = {"gnss": GNSS_KEYS, "zero_velocity": ZERO_VELOCITY_KEYS}
+REFERENCE_TABLES = {"gnss": GNSS_KEYS, "speed_log": SPEED_LOG_KEYS, "zero_velocity": ZERO_VELOCITY_KEYS}
 
 #: table name -> its keys (motion: the common keys; kinds add theirs).
 TABLES = {"motion": MOTION_COMMON, "sensors": SENSOR_KEYS, "turntable": TURNTABLE_KEYS,

@@ -34,7 +34,8 @@ def _state(fw):
 
 @pytest.mark.parametrize("eng", ["native", "reference"])
 @pytest.mark.parametrize("ref, status", [
-    (contract.make_refs("speed_log", [50], [[5.0, 0, 0]], [[0.1, 0.1, 0.1]]), "PYINS_E_REF_KIND"),
+    (contract.make_refs("dvl", [50], [[5.0, 0, 0]], [[0.1, 0.1, 0.1]]), "PYINS_E_REF_KIND"),
+    (contract.make_refs("speed_log", [50], [[5.0, 0, 0]], [[0.0, 0.1, 0.1]]), "PYINS_E_REF_VALUE"),
     (contract.make_refs(9, [50], [[0.0, 0, 0]], [[0.1, 0.1, 0.1]]), "PYINS_E_REF_KIND"),
     (contract.make_refs("gnss_pos", [50], [[np.nan, 0, 0]], [[3, 3, 5]]), "PYINS_E_REF_VALUE"),
     (contract.make_refs("gnss_pos", [50], [[2.0, 0, 0]], [[3, 3, 5]]), "PYINS_E_REF_VALUE"),

@@ -115,11 +115,25 @@ rate = "2 Hz"
     ('[references.zero_velocity]\nsigma = "0 m/s"\n', "references.zero_velocity.sigma", "out of range"),
     ('[firmware]\nnav_mode = "undamped"\n[references.gnss]\n', "firmware.nav_mode", "takes no references"),
     ('[firmware]\nnav_mode = "damped"\n', "firmware.nav_mode", "one of"),
+    ('[references.speed_log]\ncurrent = "0.2 m/s"\n', "references.speed_log.current", "horizontal"),
+    ('[references.speed_log]\nsigma = "0 m/s"\n', "references.speed_log.sigma", "out of range"),
 ])
 def test_a_bad_reference_key_is_refused_naming_it(extra, key, words):
     with pytest.raises(ScenarioError) as e:
         scenario.loads(VOYAGE + extra)
     assert e.value.key == key and words in str(e.value)
+
+
+def test_speed_log_references_are_the_logs_readings():
+    spec = _spec(VOYAGE + '[references.speed_log]\nsigma = "0.2 m/s"\ncurrent = ["0.1 m/s", "-0.2 m/s", "0 m/s"]\n'
+                 'scale_factor = 0.01\nseed = 4\n')
+    refs = spec.refs
+    assert np.all(refs["kind"] == abi.PYINS_REF_SPEED_LOG) and len(refs) == 600
+    assert np.all(refs["sigma"][:, 0] == 0.2) and np.all(refs["value"][:, 1:] == 0.0)
+    # the readings are the simulator's log in that current, scale factor and seed
+    want = references_csv.speed_log(spec.motion, 600.0, references_csv.Current(mean_enu=(0.1, -0.2)),
+                                    scale_factor=0.01, seed=4)
+    assert np.array_equal(refs["value"], want.refs["value"]) and np.array_equal(refs["tick"], want.refs["tick"])
 
 
 def test_nav_mode_goes_to_the_firmware():
