@@ -65,9 +65,13 @@ def _build_base_motion(m):
         yaw0, speed0, legs = voyage.voyage_segments(m["duration_s"] / 3600.0, seed=m["route_seed"], dt=DT)
         if m["yaw_rad"] is not None:
             yaw0 = m["yaw_rad"]
+        current = None
+        if any(m["current_mps"]) or m["current_tide_mps"]:
+            current = references.Current(mean_enu=m["current_mps"], amplitude_mps=m["current_tide_mps"],
+                                         seed=m["route_seed"])
         return sim.Voyage(lat, lon, h, yaw0, legs, speed0=speed0, dt=DT,
                           sea=None if m["sea"] == "none" else m["sea"], pitch0=m["pitch_rad"],
-                          roll0=m["roll_rad"])
+                          roll0=m["roll_rad"], current=current)
     if m["segments"] == "default":
         segments = sim.default_segments(DT)
     else:
@@ -97,7 +101,7 @@ def initial_truth(motion):
     other profile: its own state. A Manoeuvre in closed form (its ``state``
     would integrate the whole track first; the two agree bit for bit).
     """
-    if isinstance(motion, sim.Manoeuvre):
+    if isinstance(motion, sim.Manoeuvre) and motion.current is None:
         speed, _, yaw, _ = motion.kinematics(0.0)
         speed, yaw = float(speed), float(yaw)
         return (motion.lat0, motion.lon0, motion.height,
@@ -331,9 +335,8 @@ def _references(res, motion):
                                      seed=g["seed"], velocity=g["velocity"]))
     lg = rt.get("speed_log")
     if lg is not None:
-        current = references.Current(mean_enu=lg["current_mps"], amplitude_mps=lg["current_tide_mps"],
-                                     seed=lg["seed"])
-        log = references.speed_log(motion, duration, current, rate_hz=lg["rate_hz"],
+        # the water the ship moves in: a voyage's current (another motion: still water)
+        log = references.speed_log(motion, duration, getattr(motion, "current", None), rate_hz=lg["rate_hz"],
                                    scale_factor=lg["scale_factor"], bias_mps=lg["bias_mps"],
                                    noise_mps=lg["noise_mps"], seed=lg["seed"], dt=DT)
         log.refs["sigma"][:, 0] = lg["sigma_mps"]      # what the firmware is told

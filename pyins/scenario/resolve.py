@@ -88,6 +88,9 @@ def _resolve_motion(table, duration_s):
             raise ScenarioError(str(exc), "motion.lever_p") from None
     if kind == "voyage":
         res["duration_s"] = duration_s      # the route is cut there (a longer one extends it)
+        if res["current_mps"][2] != 0.0:
+            raise ScenarioError("the current is horizontal: give [E, N, 0] (its up component must be 0)",
+                                "motion.current")
     if kind == "manoeuvre":
         res["segments"] = _resolve_segments(v["segments"])
         length = _build_motion(res).duration
@@ -308,9 +311,6 @@ def _resolve_references(table, duration_s, firmware):
             if abs(step - round(step)) > 1e-6 or round(step) < 1:
                 raise ScenarioError(f"{v[rate_key]:g} Hz: 1 / rate must be a whole number of ticks "
                                     f"({DT:g} s)", f"{path}.{rate_key}")
-        if name == "speed_log" and v["current"][2] != 0.0:
-            raise ScenarioError("the current is horizontal: give [E, N, 0] (its up component must be 0)",
-                                f"{path}.current")
         if name == "gnss":
             v["outages"] = _windows(v["outages"], f"{path}.outages", duration_s)
             v["frozen"] = _windows(v["frozen"], f"{path}.frozen", duration_s)

@@ -114,6 +114,12 @@ MOTION_KINDS = {
         "sea": Key("choice", "the swing of seed 000 Table 2 on top of the track ('none': a flat sea); "
                              "the voyage heaves 0.5 m at 8 s", "general",
                    choices=("general", "ideal", "bad", "none")),
+        "current": Key("velocity", "the water current the ship drifts with, mean [E, N, 0] (its ground "
+                                   "velocity: the water velocity along the bow plus the current)", "0 m/s",
+                       lo="-10 m/s", hi="10 m/s", shape=3),
+        "current_tide": Key("velocity", "a tidal ellipse on the current, at the M2 period (12.42 h), "
+                                        "amplitude per axis (its phases from route_seed)", "0 m/s",
+                            lo="0 m/s", hi="10 m/s"),
     },
 }
 SEGMENT_KEYS = {
@@ -392,11 +398,7 @@ SPEED_LOG_KEYS = {
     "bias": Key("velocity", "bias of a reading", "0 m/s", lo="-10 m/s", hi="10 m/s"),
     "sigma": Key("velocity", "the sigma the firmware is told (noise, scale factor and what else the "
                              "reading misses)", "0.1 m/s", lo="0 m/s", hi="10 m/s", lo_open=True),
-    "current": Key("velocity", "the water current's mean, [E, N, 0]", "0 m/s", lo="-10 m/s",
-                   hi="10 m/s", shape=3),
-    "current_tide": Key("velocity", "a tidal ellipse on top, at the M2 period (12.42 h), amplitude per axis",
-                        "0 m/s", lo="0 m/s", hi="10 m/s"),
-    "seed": Key("int", "seed of the log's noise and the tide's phases (not the IMU's)", default=0, lo=0),
+    "seed": Key("int", "seed of the log's noise (not the IMU's)", default=0, lo=0),
 }
 #: [references] sub-tables -> their keys
 REFERENCE_TABLES = {"gnss": GNSS_KEYS, "speed_log": SPEED_LOG_KEYS, "zero_velocity": ZERO_VELOCITY_KEYS}

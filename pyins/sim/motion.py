@@ -418,6 +418,12 @@ class Manoeuvre(Motion):
         Constant pitch and roll [rad].
     nodes : int
         Gauss-Legendre nodes of the position quadrature (per tick and nested).
+    current : object or None
+        The water current the ship drifts with, an object with
+        ``velocity(t)`` and ``acceleration(t)`` ((N,) -> (N, 3) ENU, e.g.
+        `pyins.sim.references.Current`): the ground velocity is the speed
+        through water along the bow plus the current (the heading stays the
+        bow's: the ship crabs); None: still water.
     """
 
     _BLOCK_TICKS = 8192
@@ -425,7 +431,8 @@ class Manoeuvre(Motion):
     _TOL = 1e-15
 
     def __init__(self, lat, lon, height, yaw0, segments, dt=DT, speed0=0.0,
-                 pitch=0.0, roll=0.0, nodes=5):
+                 pitch=0.0, roll=0.0, nodes=5, current=None):
+        self.current = current
         self.lat0, self.lon0, self.height = float(lat), float(lon), float(height)
         self.yaw0 = float(yaw0)
         self.dt = float(dt)
@@ -494,7 +501,11 @@ class Manoeuvre(Motion):
 
     def _vel_ne(self, t):
         speed, _, yaw, _ = self.kinematics(t)
-        return speed * np.cos(yaw), -speed * np.sin(yaw)   # vN, vE
+        vn, ve = speed * np.cos(yaw), -speed * np.sin(yaw)
+        if self.current is None:
+            return vn, ve
+        c = self.current.velocity(np.ravel(t)).reshape(np.shape(t) + (3,))
+        return vn + c[..., 1], ve + c[..., 0]             # vN, vE over ground
 
     # -- positions ------------------------------------------------------------
     def _partial(self, t_start, tau, lat_j, lat_j1, vn=None, ve=None):
@@ -612,4 +623,7 @@ class Manoeuvre(Motion):
         euler[:, 2] = yaw
         rate = np.zeros((n, 3))
         rate[:, 2] = yaw_rate
+        if self.current is not None:          # the drift with the water
+            vel = vel + self.current.velocity(t)
+            acc = acc + self.current.acceleration(t)
         return MotionState(lat, lon, np.full(n, self.height), vel, acc, euler, rate)

@@ -214,6 +214,15 @@ class Current:
             v[:, :2] += self.amplitude_mps * np.cos(arg)
         return v
 
+    def acceleration(self, t):
+        """d/dt of `velocity` at times t [s] (1-D) -> (N, 3) [m/s^2]."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        a = np.zeros((t.shape[0], 3))
+        if self.amplitude_mps != 0.0:
+            w = TWO_PI / self.period_s
+            a[:, :2] = -self.amplitude_mps * w * np.sin(w * t[:, None] + self.phase)
+        return a
+
 
 def _water(current, t):
     return 0.0 if current is None else current.velocity(t)

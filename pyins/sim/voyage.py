@@ -19,6 +19,10 @@ Model (n = ENU, Euler [pitch, roll, yaw], docs/design.md §2)
 Track (`Manoeuvre`): speed v(t), course psi_c(t) (yaw convention,
 counter-clockwise from North), vN_h = v cos psi_c, vE_h = -v sin psi_c, and
 lat, lon from lat_dot = vN_h / (R_M + h0), lon_dot = vE_h / ((R_N + h0) cos lat).
+With a water ``current`` c(t) (`pyins.sim.references.Current`), v is the
+speed through the water along the bow and the ground velocity is
+[vE_h, vN_h] + c: the ship crabs (its heading stays psi_c), its positions
+integrate the drift, its acceleration gains c'.
 
 Heave: h = h0 + z(t), z = sum_i a_i sin(2 pi t / T_i + phi_i) (phases exact
 over long runs, `pyins.sim.exact_time`). The track's lat, lon are kept; the
@@ -161,14 +165,19 @@ class Voyage(Motion):
         Trim and list [rad].
     nodes : int
         Gauss-Legendre nodes of the track's position quadrature.
+    current : object or None
+        The water current the ship drifts with (`Manoeuvre`'s ``current``,
+        e.g. `pyins.sim.references.Current`); None: still water.
     """
 
     frequencies_hz = None
 
     def __init__(self, lat, lon, height, yaw0, segments, speed0=0.0, dt=DT, sea="general",
                  sea_phase=(0.0, 0.0, 0.0), heave=HEAVE, heel_factor=1.0, pitch0=0.0,
-                 roll0=0.0, nodes=5):
-        self.track = Manoeuvre(lat, lon, height, yaw0, segments, dt=dt, speed0=speed0, nodes=nodes)
+                 roll0=0.0, nodes=5, current=None):
+        self.track = Manoeuvre(lat, lon, height, yaw0, segments, dt=dt, speed0=speed0, nodes=nodes,
+                               current=current)
+        self.current = current
         self.lat0, self.lon0, self.height = self.track.lat0, self.track.lon0, self.track.height
         self.dt = self.track.dt
         self.duration = self.track.duration

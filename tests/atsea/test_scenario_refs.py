@@ -115,7 +115,7 @@ rate = "2 Hz"
     ('[references.zero_velocity]\nsigma = "0 m/s"\n', "references.zero_velocity.sigma", "out of range"),
     ('[firmware]\nnav_mode = "undamped"\n[references.gnss]\n', "firmware.nav_mode", "takes no references"),
     ('[firmware]\nnav_mode = "damped"\n', "firmware.nav_mode", "one of"),
-    ('[references.speed_log]\ncurrent = "0.2 m/s"\n', "references.speed_log.current", "horizontal"),
+    ('current = "0.2 m/s"\n', "motion.current", "horizontal"),
     ('[references.speed_log]\nsigma = "0 m/s"\n', "references.speed_log.sigma", "out of range"),
 ])
 def test_a_bad_reference_key_is_refused_naming_it(extra, key, words):
@@ -125,15 +125,20 @@ def test_a_bad_reference_key_is_refused_naming_it(extra, key, words):
 
 
 def test_speed_log_references_are_the_logs_readings():
-    spec = _spec(VOYAGE + '[references.speed_log]\nsigma = "0.2 m/s"\ncurrent = ["0.1 m/s", "-0.2 m/s", "0 m/s"]\n'
-                 'scale_factor = 0.01\nseed = 4\n')
+    spec = _spec(VOYAGE + 'current = ["0.1 m/s", "-0.2 m/s", "0 m/s"]\ncurrent_tide = "0.05 m/s"\n'
+                 '[references.speed_log]\nsigma = "0.2 m/s"\nscale_factor = 0.01\nseed = 4\n')
     refs = spec.refs
     assert np.all(refs["kind"] == abi.PYINS_REF_SPEED_LOG) and len(refs) == 600
     assert np.all(refs["sigma"][:, 0] == 0.2) and np.all(refs["value"][:, 1:] == 0.0)
-    # the readings are the simulator's log in that current, scale factor and seed
-    want = references_csv.speed_log(spec.motion, 600.0, references_csv.Current(mean_enu=(0.1, -0.2)),
-                                    scale_factor=0.01, seed=4)
+    # the voyage drifts with its current; the log reads the simulator's log in that water
+    cur = spec.motion.current
+    assert np.array_equal(cur.mean_enu, [0.1, -0.2, 0.0]) and cur.amplitude_mps == 0.05 and cur.seed == 3
+    want = references_csv.speed_log(spec.motion, 600.0, cur, scale_factor=0.01, seed=4)
     assert np.array_equal(refs["value"], want.refs["value"]) and np.array_equal(refs["tick"], want.refs["tick"])
+    st = spec.motion.state(np.array([0.0, 300.0]))
+    still = _spec(VOYAGE).motion.state(np.array([0.0, 300.0]))
+    np.testing.assert_allclose(st.vel_n[:, :2] - still.vel_n[:, :2], cur.velocity(np.array([0.0, 300.0]))[:, :2],
+                               atol=1e-9)
 
 
 def test_nav_mode_goes_to_the_firmware():

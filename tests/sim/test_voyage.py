@@ -176,3 +176,49 @@ def test_firmware_navigates_a_voyage_1h():
     assert np.abs(e.vel_n_mps[:, 2]).max() < 1e-3           # m/s, free vertical channel
     assert np.abs(up).max() < 0.2                           # m, heave 0.5 m followed
     assert att < 0.01                                        # arcsec, as test_error_free_nav
+
+
+# --- a voyage in a current ----------------------------------------------------------
+def test_a_voyage_drifts_with_its_current():
+    """The ground velocity is the water velocity along the bow plus the
+    current (the ship crabs); acceleration and position stay the exact
+    derivative and integral of it, and the ship ends where the current has
+    carried it."""
+    from pyins.sim.references import Current
+    cur = Current(mean_enu=(0.3, -0.2), amplitude_mps=0.2, period_s=3600.0, seed=2)   # a fast tide
+    m = V.default_voyage(1.0, seed=1, sea="bad", current=cur)
+    still = V.default_voyage(1.0, seed=1, sea="bad")
+    t = _times(m, 2000)
+    st, st0 = m.state(t), still.state(t)
+    # the water velocity is the still voyage's (along the bow); the difference
+    # is the current, up to the height factor of vel_n (z / R ~ 1e-7 of it)
+    np.testing.assert_allclose(st.vel_n[:, :2] - st0.vel_n[:, :2], cur.velocity(t)[:, :2], atol=1e-7)
+    np.testing.assert_array_equal(st.euler, st0.euler)            # the heading is the bow's
+    # the acceleration is the velocity's derivative (as test_derivatives: 1e-10 m/s^2)
+    h = 2.0 ** -10
+    th = np.round(t / h) * h
+    acc_fd = central_diff(lambda s: m.state(s).vel_n, th, h)
+    assert np.max(np.abs(acc_fd - m.state(th).acc_n)) < 1e-10
+    # where the current carried it after 1 h, north: the integral of the
+    # current (closed form) to 1 mm (R_M changes by ~1e-7 over the drift);
+    # east the longitude also takes cos(lat) at the drifted latitude, so it
+    # is held by the integral of the velocity below
+    w = 2.0 * np.pi / 3600.0
+    drift_n = -0.2 * 3600.0 + 0.2 / w * (np.sin(w * 3600.0 + cur.phase[1]) - np.sin(cur.phase[1]))
+    end, end0 = m.state(np.array([3600.0])), still.state(np.array([3600.0]))
+    rm, _ = earth.principal_radii(np.sin(end.lat[0]))
+    assert abs((end.lat[0] - end0.lat[0]) * rm - drift_n) < 1e-3
+    # the position is the integral of the velocity (test_position_is_the_integral_of_velocity's
+    # quadrature and bound: 1e-7 m)
+    x, wq = np.polynomial.legendre.leggauss(8)
+    n = int(m.duration)
+    tq = (np.arange(n)[:, None] + 0.5 * (1.0 + x)).ravel()
+    sq = m.state(tq)
+    rm, rn = earth.principal_radii(np.sin(sq.lat))
+    dlat = np.concatenate(([0.0], np.cumsum(0.5 * (sq.vel_n[:, 1] / (rm + sq.height)).reshape(n, 8) @ wq)))
+    dlon = np.concatenate(([0.0], np.cumsum(
+        0.5 * (sq.vel_n[:, 0] / ((rn + sq.height) * np.cos(sq.lat))).reshape(n, 8) @ wq)))
+    ends = m.state(np.arange(n + 1.0))
+    rm0, rn0 = earth.principal_radii(np.sin(ends.lat))
+    err = np.hypot((ends.lat - ends.lat[0] - dlat) * rm0, (ends.lon - ends.lon[0] - dlon) * rn0 * np.cos(ends.lat))
+    assert err.max() < 1e-7
