@@ -232,6 +232,11 @@ class Firmware {
     /// without a lever arm).
     void ref_point_vel(double* east, double* north) const;
     void apply_log(const pyins_ref& ref, int32_t slot);
+    /// A reference of kind slot + 1 failed its gate: counted; nav_reject_limit
+    /// in a row put the kind out of use and set PYINS_FAULT_REF_REJECTED.
+    void reject_ref(int32_t slot);
+    /// A reference of kind slot + 1 passed its gate: counted, the kind in use.
+    void use_ref(int32_t slot);
     /// Apply the references whose tick has come (tick_ just advanced).
     void refs_due();
     /// Gate and apply one reference now (lag: ticks since its tick).

@@ -152,6 +152,24 @@ void Firmware::refs_due() {
     }
 }
 
+void Firmware::reject_ref(int32_t slot) {
+    count(&n_ref_rejected_[slot], 1u);
+    if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
+        ref_reject_run_[slot] = ref_reject_run_[slot] + 1;
+    }
+    if (ref_reject_run_[slot] == cfg_.nav_reject_limit) {
+        ref_out_[slot] = 1;
+        faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_REF_REJECTED);
+    }
+}
+
+void Firmware::use_ref(int32_t slot) {
+    ref_reject_run_[slot] = 0;
+    ref_out_[slot] = 0;
+    count(&n_ref_used_[slot], 1u);
+    ref_used_tick_[slot] = tick_;
+}
+
 void Firmware::bow_n(double* east, double* north) const {
     // C_b^n = C_p^n C_b^p; its column 1 (the bow) is (C01, C11, C21)
     const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
@@ -205,20 +223,10 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     const double nis = innov * innov / (ref.sigma[0] * ref.sigma[0] + pvv);
     nav_nis_[slot] = nis;
     if (!(nis <= cfg_.nav_gate)) {   // a NaN fails too
-        count(&n_ref_rejected_[slot], 1u);
-        if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
-            ref_reject_run_[slot] = ref_reject_run_[slot] + 1;
-        }
-        if (ref_reject_run_[slot] == cfg_.nav_reject_limit) {
-            ref_out_[slot] = 1;
-            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_REF_REJECTED);
-        }
+        reject_ref(slot);
         return;
     }
-    ref_reject_run_[slot] = 0;
-    ref_out_[slot] = 0;
-    count(&n_ref_used_[slot], 1u);
-    ref_used_tick_[slot] = tick_;
+    use_ref(slot);
     log_speed_ = v_log;
     // the current: the mean of the first kCurrentReadings readings, then a
     // low-pass while the velocity is known (GNSS velocity or zero velocity
@@ -370,20 +378,10 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         }
     }
     if (stale || !(nis <= cfg_.nav_gate)) {   // a NaN fails too
-        count(&n_ref_rejected_[slot], 1u);
-        if (ref_reject_run_[slot] < cfg_.nav_reject_limit) {
-            ref_reject_run_[slot] = ref_reject_run_[slot] + 1;
-        }
-        if (ref_reject_run_[slot] == cfg_.nav_reject_limit) {
-            ref_out_[slot] = 1;
-            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_REF_REJECTED);
-        }
+        reject_ref(slot);
         return;
     }
-    ref_reject_run_[slot] = 0;
-    ref_out_[slot] = 0;
-    count(&n_ref_used_[slot], 1u);
-    ref_used_tick_[slot] = tick_;
+    use_ref(slot);
     nav_filter::update_pair(nav_, k, z, r);
     if (nav_.healthy == 0) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);

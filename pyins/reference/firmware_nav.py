@@ -106,6 +106,22 @@ class NavAtSea:
                 self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
             self.damp_interval()
 
+    def reject_ref(self, slot):
+        """A reference failed its gate (mirrors reject_ref)."""
+        self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
+        if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
+            self.ref_reject_run[slot] += 1
+        if self.ref_reject_run[slot] == self.cfg["nav_reject_limit"]:
+            self.ref_out[slot] = 1
+            self.faults = self.faults | abi.PYINS_FAULT_REF_REJECTED
+
+    def use_ref(self, slot):
+        """A reference passed its gate (mirrors use_ref)."""
+        self.ref_reject_run[slot] = 0
+        self.ref_out[slot] = 0
+        self.n_ref_used[slot] = count(self.n_ref_used[slot])
+        self.ref_used_tick[slot] = self.tick
+
     def bow_n(self):
         """The bow's horizontal direction in n (E, N; unit): C_b^n's column 1."""
         w, x, y, z = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
@@ -136,17 +152,9 @@ class NavAtSea:
         nis = innov * innov / (sigma[0] * sigma[0] + pvv)
         self.nav_nis[slot] = nis
         if not nis <= self.cfg["nav_gate"]:
-            self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
-            if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
-                self.ref_reject_run[slot] += 1
-            if self.ref_reject_run[slot] == self.cfg["nav_reject_limit"]:
-                self.ref_out[slot] = 1
-                self.faults = self.faults | abi.PYINS_FAULT_REF_REJECTED
+            self.reject_ref(slot)
             return
-        self.ref_reject_run[slot] = 0
-        self.ref_out[slot] = 0
-        self.n_ref_used[slot] = count(self.n_ref_used[slot])
-        self.ref_used_tick[slot] = self.tick
+        self.use_ref(slot)
         self.log_speed = v_log
         known = (1 << (abi.PYINS_REF_GNSS_VEL - 1)) | (1 << (abi.PYINS_REF_ZERO_VEL - 1))
         n = float(CURRENT_READINGS)
@@ -284,17 +292,9 @@ class NavAtSea:
             if not stale:
                 return
         if stale or not nis <= self.cfg["nav_gate"]:
-            self.n_ref_rejected[slot] = count(self.n_ref_rejected[slot])
-            if self.ref_reject_run[slot] < self.cfg["nav_reject_limit"]:
-                self.ref_reject_run[slot] += 1
-            if self.ref_reject_run[slot] == self.cfg["nav_reject_limit"]:
-                self.ref_out[slot] = 1
-                self.faults = self.faults | abi.PYINS_FAULT_REF_REJECTED
+            self.reject_ref(slot)
             return
-        self.ref_reject_run[slot] = 0
-        self.ref_out[slot] = 0
-        self.n_ref_used[slot] = count(self.n_ref_used[slot])
-        self.ref_used_tick[slot] = self.tick
+        self.use_ref(slot)
         nav_filter.update_pair(self.nav, k, z, r)
         if self.nav.healthy == 0:
             self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD

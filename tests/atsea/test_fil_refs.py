@@ -10,8 +10,6 @@ run drifts by a hundred metres; the NumPy mirror agrees over two minutes;
 a killed run resumes bit-identical, its position among the references
 derived from the tick; a checkpoint of other references is refused."""
 import functools
-import json
-import os
 import signal
 import subprocess
 import sys
@@ -20,6 +18,7 @@ import time
 import numpy as np
 import pytest
 
+import killing
 from pyins import aiding, contract, fil, metrics, records, sim
 from pyins.reference import attitude
 from pyins.sim import references
@@ -255,19 +254,6 @@ def _ck_run(record_dir, refs, avail_tick=None, **kw):
                        record_dir=record_dir, **kw)
 
 
-def _wait_for_checkpoint(path, proc, min_done, timeout=120.0):
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout:
-        assert proc.poll() is None, "the run ended before it could be killed"
-        if os.path.exists(path):
-            try:
-                with open(path) as f:
-                    if json.load(f)["done_ticks"] >= min_done:
-                        return
-            except (ValueError, KeyError):
-                pass
-        time.sleep(0.02)
-    raise AssertionError("no checkpoint appeared")
 
 
 def test_killed_run_with_refs_resumes_bit_identical(tmp_path):
@@ -276,7 +262,7 @@ def test_killed_run_with_refs_resumes_bit_identical(tmp_path):
     cut = tmp_path / "cut"
     proc = subprocess.Popen([sys.executable, "-c", RUN, str(cut)])
     try:
-        _wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CK_CHUNK)
+        killing.wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CK_CHUNK)
         time.sleep(0.15)                 # a chunk past the checkpoint
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=30)

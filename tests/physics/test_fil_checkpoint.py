@@ -6,7 +6,6 @@ SIGKILL in a subprocess once it has checkpointed, then resumed in this
 process: its records must be bit-identical to an uninterrupted run (the
 firmware snapshot, the plant state and the noise generator all resume), and
 nothing written before the kill is lost."""
-import os
 import signal
 import subprocess
 import sys
@@ -15,6 +14,7 @@ import time
 import numpy as np
 import pytest
 
+import killing
 from pyins import fil, records, sim
 
 TICKS = 240_000                  # 40 min of ship time: 12 chunks of 20,000
@@ -35,20 +35,6 @@ def _run(record_dir, **kw):
                        record_dir=record_dir, **kw)
 
 
-def _wait_for_checkpoint(path, proc, min_done, timeout=120.0):
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout:
-        assert proc.poll() is None, "the run ended before it could be killed"
-        if os.path.exists(path):
-            import json
-            try:
-                with open(path) as f:
-                    if json.load(f)["done_ticks"] >= min_done:
-                        return
-            except (ValueError, KeyError):
-                pass                      # never happens with the atomic rename; keep polling
-        time.sleep(0.02)
-    raise AssertionError("no checkpoint appeared")
 
 
 def test_killed_run_resumes_bit_identical(tmp_path):
@@ -56,7 +42,7 @@ def test_killed_run_resumes_bit_identical(tmp_path):
     cut = tmp_path / "cut"
     proc = subprocess.Popen([sys.executable, "-c", RUN, str(cut)])
     try:
-        _wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CHUNK)
+        killing.wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CHUNK)
         time.sleep(0.08)                 # let it write a chunk past the checkpoint
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=30)
