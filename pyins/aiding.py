@@ -17,7 +17,7 @@ import numpy as np
 
 from . import contract
 
-__all__ = ["Aider", "run_with_refs"]
+__all__ = ["Aider", "BlockFeed", "concat", "run_with_refs"]
 
 #: How far ahead of its tick a reference is pushed when no availability is
 #: given [ticks at 100 Hz]: half the firmware's 10 s horizon.
@@ -26,6 +26,21 @@ _AHEAD_S = 5
 
 def _tick(fw):
     return int(fw.nav()["tick"])
+
+
+def concat(parts, dtype):
+    """The record arrays ``parts`` end to end (``dtype`` when there are
+    none): one array, the same bytes as np.concatenate, without its field
+    promotion, which costs ~25 us a part for a structured dtype (a 72 h run
+    with a 1 Hz GNSS joins ~260,000 parts)."""
+    if len(parts) == 1:
+        return parts[0]
+    out = np.empty(sum(len(p) for p in parts), dtype=parts[0].dtype if parts else dtype)
+    i = 0
+    for p in parts:
+        out[i:i + len(p)] = p
+        i += len(p)
+    return out
 
 
 class Aider:
@@ -140,7 +155,7 @@ class Aider:
             parts.append(call(samples[i:stop], every))
             i = stop
         dtype = contract.NAV_DTYPE if compact else contract.OUTPUT_DTYPE
-        return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+        return concat(parts, dtype)
 
 
 def run_with_refs(fw, samples, refs, every=100, avail_tick=None, compact=False, tick_hz=100):

@@ -39,7 +39,7 @@ import numpy as np
 
 from pyins import engine as engines
 from pyins import contract, records, sim
-from pyins.aiding import Aider
+from pyins.aiding import Aider, concat
 from pyins.records import CHECKPOINT, PLANT_RECORD_DTYPE, FilResult, load_records
 from pyins.scenario.build import initial_config
 from pyins.sim.turntable import TableConfig, error_matrices
@@ -154,11 +154,7 @@ def _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0, g_noise
 
 def _joined(outs, recs):
     """The parts of a chunk as one array each (a single part as it is)."""
-    if len(outs) == 1:
-        return outs[0], recs[0]
-    if not outs:
-        return np.zeros(0, dtype=contract.OUTPUT_DTYPE), np.zeros(0, dtype=PLANT_RECORD_DTYPE)
-    return np.concatenate(outs), np.concatenate(recs)
+    return concat(outs, contract.OUTPUT_DTYPE), concat(recs, PLANT_RECORD_DTYPE)
 
 
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
