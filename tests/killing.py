@@ -1,6 +1,9 @@
 """Helpers of the tests that kill a run and resume it."""
 import json
 import os
+import signal
+import subprocess
+import sys
 import time
 
 
@@ -20,3 +23,19 @@ def wait_for_checkpoint(path, proc, min_done, timeout=120.0):
                 pass                      # never happens with the atomic rename; keep polling
         time.sleep(0.02)
     raise AssertionError("no checkpoint appeared")
+
+
+def kill_after_checkpoint(code, record_dir, checkpoint, min_done, settle_s):
+    """Run ``code`` (a Python script taking ``record_dir`` as argv[1]) in a
+    subprocess, wait for its checkpoint file ``checkpoint`` to say
+    ``min_done`` ticks, let it run ``settle_s`` more seconds (a chunk past
+    the checkpoint) and kill it with SIGKILL."""
+    proc = subprocess.Popen([sys.executable, "-c", code, str(record_dir)])
+    try:
+        wait_for_checkpoint(str(checkpoint), proc, min_done)
+        time.sleep(settle_s)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()

@@ -10,9 +10,6 @@ run drifts by a hundred metres; the NumPy mirror agrees over two minutes;
 a killed run resumes bit-identical, its position among the references
 derived from the tick; a checkpoint of other references is refused."""
 import functools
-import signal
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -260,15 +257,7 @@ def test_killed_run_with_refs_resumes_bit_identical(tmp_path):
     g = _gnss(_voyage(), TICKS / 100)
     whole = _ck_run(str(tmp_path / "whole"), g.refs)
     cut = tmp_path / "cut"
-    proc = subprocess.Popen([sys.executable, "-c", RUN, str(cut)])
-    try:
-        killing.wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CK_CHUNK)
-        time.sleep(0.15)                 # a chunk past the checkpoint
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    killing.kill_after_checkpoint(RUN, cut, cut / records.CHECKPOINT, 4 * CK_CHUNK, 0.15)   # a chunk past the checkpoint
     part_out, _, info = records.load_records(str(cut))
     assert not info["complete"] and 0 < len(part_out) < len(whole.outputs)
     assert part_out.tobytes() == np.asarray(whole.outputs[:len(part_out)]).tobytes()

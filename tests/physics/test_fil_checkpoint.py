@@ -6,10 +6,6 @@ SIGKILL in a subprocess once it has checkpointed, then resumed in this
 process: its records must be bit-identical to an uninterrupted run (the
 firmware snapshot, the plant state and the noise generator all resume), and
 nothing written before the kill is lost."""
-import signal
-import subprocess
-import sys
-import time
 
 import numpy as np
 import pytest
@@ -40,15 +36,7 @@ def _run(record_dir, **kw):
 def test_killed_run_resumes_bit_identical(tmp_path):
     whole = _run(str(tmp_path / "whole"))
     cut = tmp_path / "cut"
-    proc = subprocess.Popen([sys.executable, "-c", RUN, str(cut)])
-    try:
-        killing.wait_for_checkpoint(str(cut / records.CHECKPOINT), proc, 4 * CHUNK)
-        time.sleep(0.08)                 # let it write a chunk past the checkpoint
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    killing.kill_after_checkpoint(RUN, cut, cut / records.CHECKPOINT, 4 * CHUNK, 0.08)   # let it write a chunk past the checkpoint
     # what was written before the kill is readable and is the start of the whole run
     part_out, part_plant, info = records.load_records(str(cut))
     assert not info["complete"] and 0 < len(part_out) < len(whole.outputs)
