@@ -6,11 +6,15 @@ and Cortex-M4F under QEMU, on the demo scenario of csrc/embedded.
         [--m7 build-m7/demo.elf] [--m4 build-m4/demo.elf] [--json runs/bench/embedded.json]
 
 Every build prints the same lines (every 500 samples: the sample number,
-mode, index state, fault bits, tick, the sample-level counters and eleven
+mode, index state, fault bits, tick, the sample-level counters, the
+navigation mode with the references in use, used and rejected, and fourteen
 doubles as hex; an "S k status" line for every sample whose status is not
-PYINS_OK). The Python run replays the scenario's integer-only sample
-generator and its fault schedule (csrc/embedded/demo_scenario.c) through the
-installed package. Any difference is a failure naming the first differing
+PYINS_OK, an "R k kind status" line for every reference refused). The Python
+run replays the scenario's integer-only sample and reference generators and
+its fault schedule (csrc/embedded/demo_scenario.c) through the installed
+package: the navigation runs UNDAMPED, INTEGRATED with GNSS (one outlier
+rejected, fixes pushed 0.2 s late), DAMPED by the speed log alone, and
+UNDAMPED again after the encoder glitch turns the bow. Any difference is a failure naming the first differing
 tick and field; exit status 1.
 """
 import argparse
@@ -25,7 +29,7 @@ import numpy as np
 from pyins import native
 
 FIELDS = ["lat_rad", "lon_rad", "vel_E", "vel_N", "quat_nb_w", "quat_nb_x", "quat_nb_y", "quat_nb_z",
-          "kf_x_2", "table_angle_cmd_rad", "index_a_c"]
+          "kf_x_2", "table_angle_cmd_rad", "index_a_c", "nav_sigma_pos_m", "nav_gyro_bias_x", "nav_nis_gnss_pos"]
 TWO_PI = 6.283185307179586
 DEMO_NONE, DEMO_DROP, DEMO_REPEAT, DEMO_NAN, DEMO_SATURATE, DEMO_ENCODER_GLITCH = range(6)
 
@@ -39,6 +43,32 @@ def demo_fault(k):
     return {16000: DEMO_NAN, 17000: DEMO_SATURATE, 23000: DEMO_ENCODER_GLITCH}.get(k, DEMO_NONE)
 
 
+DEMO_NAV_TICK, DEMO_GNSS_END, DEMO_OUTLIER_TICK, DEMO_LOG_TICK = 12000, 18500, 16500, 14000
+K_POS = 1.0 / 1099511627776.0      # 2^-40 rad per LCG unit
+K_REF_VEL = 1.0 / 16777216.0       # 2^-24 m/s per LCG unit
+
+
+def demo_refs(unit, k):
+    """The references of demo_scenario.c (demo_refs) before sample k:
+    (kind, tick, value, sigma) tuples; unit() draws the references' LCG."""
+    t = k + 1
+    refs = []
+    if t <= DEMO_NAV_TICK + 100:
+        return refs
+    if t % 100 == 0 and t <= DEMO_GNSS_END:
+        ve = unit() * K_REF_VEL
+        vn = unit() * K_REF_VEL
+        refs.append((2, t, (ve, vn, 0.0), (0.0625, 0.0625, 0.0625)))
+    if t % 100 == 20 and t <= DEMO_GNSS_END + 20:
+        tf = t - 20
+        dlat = (1e-4 if tf == DEMO_OUTLIER_TICK else 0.0) + unit() * K_POS
+        dlon = unit() * K_POS
+        refs.append((1, tf, (0.5977054556379782 + dlat, 1.9008380883470242 + dlon, 0.0), (3.0, 3.0, 5.0)))
+    if t % 100 == 50 and t > DEMO_LOG_TICK:
+        refs.append((3, t, (unit() * K_REF_VEL, 0.0, 0.0), (0.0625, 0.0, 0.0)))
+    return refs
+
+
 def python_lines():
     """The demo of csrc/embedded/demo_main.c through pyins.native."""
     ffi, lib = native.ffi, native.lib
@@ -48,24 +78,37 @@ def python_lines():
                fine_site_accel=0.009765625)
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
-    state = 1
+    states = {"samples": 1, "refs": 12345}
     mask = (1 << 64) - 1
     k_ang = 1.0 / 1099511627776.0 / 1048576.0
     k_vel = 1.0 / 1073741824.0 / 1048576.0
 
-    def unit():
-        nonlocal state
-        state = (state * 6364136223846793005 + 1442695040888963407) & mask
-        return float((state >> 43) - (1 << 20))
+    def draw(which):
+        states[which] = (states[which] * 6364136223846793005 + 1442695040888963407) & mask
+        return float((states[which] >> 43) - (1 << 20))
 
-    enc = 0.0
+    def unit():
+        return draw("samples")
+
+    enc = cmd = cmd_prev = 0.0
     sample = ffi.new("pyins_sample *")
     out = ffi.new("pyins_output *")
+    ref = ffi.new("pyins_ref *")
     for k in range(24000):
         fault = demo_fault(k)
+        for kind, tick, value, sigma in demo_refs(lambda: draw("refs"), k):
+            ref.kind, ref.reserved, ref.tick = kind, 0, tick
+            ref.value[0:3] = list(value)
+            ref.sigma[0:3] = list(sigma)
+            st = lib.pyins_push_ref(fw.core, ref)
+            if st != 0:
+                lines.append(f"R {k} {kind} {st}")
+        step = cmd - cmd_prev
+        step = 0.0 if step > 0.1 or step < -0.1 else step   # a reset's jump is not a motion
+        side = -1.0 if 1.5707963267948966 < enc < 4.71238898038469 else 1.0
         sample.dtheta_p_rad[0] = unit() * k_ang
-        sample.dtheta_p_rad[1] = 6.027874130954723e-07 + unit() * k_ang
-        sample.dtheta_p_rad[2] = 4.103617522881293e-07 + unit() * k_ang
+        sample.dtheta_p_rad[1] = side * 6.027874130954723e-07 + unit() * k_ang
+        sample.dtheta_p_rad[2] = 4.103617522881293e-07 + step + unit() * k_ang
         sample.dv_p_mps[0] = unit() * k_vel
         sample.dv_p_mps[1] = unit() * k_vel
         sample.dv_p_mps[2] = (0.09796698857772466 + unit() * k_vel
@@ -89,19 +132,26 @@ def python_lines():
         if out.index_state == lib.PYINS_INDEX_FAULT:
             lib.pyins_index_reset(fw.core)
             lib.pyins_get_output(fw.core, out)
-        enc = out.table_angle_cmd_rad
+        cmd_prev = cmd
+        cmd = out.table_angle_cmd_rad
+        enc = cmd
         while enc >= TWO_PI:
             enc -= TWO_PI
         while enc < 0.0:
             enc += TWO_PI
         if (k + 1) % 500 == 0:
             vals = [out.lat_rad, out.lon_rad, out.vel_n_mps[0], out.vel_n_mps[1], *list(out.quat_nb),
-                    out.kf_x[2], out.table_angle_cmd_rad, out.index_a_c]
+                    out.kf_x[2], out.table_angle_cmd_rad, out.index_a_c, out.nav_sigma_pos_m,
+                    out.nav_gyro_bias_rad_s[0], out.nav_nis[0]]
             hexes = " ".join(struct.pack(">d", v).hex() for v in vals)
             counts = "/".join(str(getattr(out, f)) for f in ("n_nonfinite", "n_saturated", "n_seq_gaps",
                                                             "n_seq_bridged", "n_seq_repeats", "n_seq_lost",
                                                             "n_encoder_jumps"))
-            lines.append(f"{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {hexes}")
+            nav = "/".join(str(v) for v in (out.nav_mode, f"{out.ref_in_use:x}", out.n_ref_used[0],
+                                            out.n_ref_rejected[0], out.n_ref_used[1], out.n_ref_rejected[1],
+                                            out.n_ref_used[2], out.n_ref_rejected[2]))
+            lines.append(f"{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {nav} "
+                         f"{hexes}")
     lines.append("DONE")
     return lines
 
@@ -111,7 +161,7 @@ def run_lines(cmd):
     return res.stdout.strip().splitlines(), res.returncode
 
 
-N_INTS = 6   # sample number, mode, index state, fault bits, tick, counters; then the doubles
+N_INTS = 7   # sample number, mode, index state, fault bits, tick, counters, nav counters; then the doubles
 
 
 def first_difference(a, b):
@@ -131,6 +181,24 @@ def first_difference(a, b):
     return None
 
 
+def softfp_wrong(lines):
+    """The cases of csrc/embedded/softfp_check.c ("op a b result" in hex)
+    whose result is not the host's IEEE 754 double (correctly rounded):
+    (count checked, [(op, exponent difference, line), ...])."""
+    wrong, n = [], 0
+    for line in lines:
+        t = line.split()
+        if len(t) != 4:
+            continue
+        op = int(t[0])
+        a, b = (struct.unpack(">d", bytes.fromhex(x))[0] for x in t[1:3])
+        want = a - b if op == 0 else a + b if op == 1 else b - a
+        n += 1
+        if struct.pack(">d", want).hex() != t[3]:
+            wrong.append((op, (int(t[1][:3], 16) & 0x7ff) - (int(t[2][:3], 16) & 0x7ff), line))
+    return n, wrong
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--host", default=os.path.join("build", "host", "demo_host"))
@@ -144,6 +212,13 @@ def main(argv=None):
     for name, elf, board in (("cortex-m7", args.m7, "mps2-an500"), ("cortex-m4f", args.m4, "mps2-an386")):
         if os.path.exists(elf):
             runs[name] = run_lines(["qemu-system-arm", "-M", board, "-nographic", "-semihosting", "-kernel", elf])
+    softfp = {}
+    for name, elf, board in (("cortex-m7", args.m7, "mps2-an500"), ("cortex-m4f", args.m4, "mps2-an386")):
+        check = os.path.join(os.path.dirname(elf), "softfp_check.elf")
+        if os.path.exists(check):
+            lines, rc = run_lines(["qemu-system-arm", "-M", board, "-nographic", "-semihosting", "-kernel", check])
+            n, wrong = softfp_wrong(lines)
+            softfp[name] = (n, wrong, rc)
     ref_name = "host" if "host" in runs else "python"
     ref = runs[ref_name][0]
     ok = True
@@ -154,6 +229,13 @@ def main(argv=None):
         ok = ok and same
         result[f"{name}_identical"] = same
         print(f"{name:11s} {'bit-identical to ' + ref_name if same else 'DIFFERS: ' + str(diff or f'exit {rc}')}")
+    for name, (n, wrong, rc) in softfp.items():
+        good = not wrong and rc == 0 and n == 60000
+        ok = ok and good
+        result[f"{name}_softfp_wrong"] = len(wrong)
+        print(f"{name:11s} {n} double sums and differences: "
+              + ("all as the host's" if good else f"{len(wrong)} differ from the host's (exit {rc}); first: "
+                 f"op {wrong[0][0]}, exponent difference {wrong[0][1]}: {wrong[0][2]}" if wrong else f"exit {rc}"))
     os.makedirs(os.path.dirname(os.path.abspath(args.json)), exist_ok=True)
     with open(args.json, "w") as f:
         json.dump(result, f, indent=2)

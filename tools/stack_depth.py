@@ -174,7 +174,8 @@ class Image:
                     out.add(owner)
         # fall-through into the next symbol: decided by the last real
         # instruction (not literal-pool words or alignment nops)
-        real = [i for i in ins_list if not re.match(r"^(\.word|\.short|\.byte|nop|\.inst)", i)]
+        # (0x0000 padding after a function decodes as "movs r0, r0")
+        real = [i for i in ins_list if not re.match(r"^(\.word|\.short|\.byte|nop|\.inst|movs\s+r0,\s*r0$)", i)]
         if real and not self.TERMINAL.match(real[-1]) and addr in self.next_block:
             out.add(self.next_block[addr])
         return out

@@ -1,7 +1,8 @@
 /* demo_main.c: run the demo scenario through the firmware and print, every
  * DEMO_PRINT_EVERY samples, the output record's mode, index state, fault
- * bits, tick, sample-level counters and key doubles as hex, and one "S" line
- * per sample whose status is not PYINS_OK (the same program on the host and
+ * bits, tick, sample-level counters, the navigation mode and reference
+ * counters, and key doubles as hex, one "S" line per sample whose status is
+ * not PYINS_OK and one "R" line per reference the core refused (the same program on the host and
  * under QEMU on Cortex-M7 and M4F; the lines must be identical). An indexing
  * FAULT (from the scheduled encoder glitch) is reset. Ends with "DONE" and
  * returns 0, or prints the failing status. */
@@ -26,7 +27,9 @@ int main(void) {
     pyins_sample s;
     pyins_output out;
     uint64_t lcg = 1;
+    uint64_t lcg_refs = 12345u;
     double enc = 0.0;
+    double cmd = 0.0, cmd_prev = 0.0;   /* the unwrapped commanded angle, now and a tick ago */
     uint32_t k;
     int st;
     if (pyins_core_size() > sizeof g_mem) {
@@ -46,7 +49,23 @@ int main(void) {
         /* a dropped sample is lost on the way: the core sees the seq gap on the next one */
         const int steps = fault == DEMO_DROP ? 0 : (fault == DEMO_REPEAT ? 2 : 1);
         int rep;
-        demo_sample(&lcg, k, enc, &s);
+        {
+            /* the IMU turns with the table; a reset's jump of the command (the
+               glitched reading it restarts from) is not a motion */
+            const double step = cmd - cmd_prev;
+            demo_sample(&lcg, k, enc, step > 0.1 || step < -0.1 ? 0.0 : step, &s);
+        }
+        {
+            pyins_ref refs[DEMO_MAX_REFS];
+            const int n_refs = demo_refs(&lcg_refs, k, refs);
+            int r;
+            for (r = 0; r < n_refs; ++r) {
+                st = pyins_push_ref((pyins_core *)g_mem, &refs[r]);
+                if (st != PYINS_OK) {
+                    printf("R %lu %ld %d\n", (unsigned long)k, (long)refs[r].kind, st);
+                }
+            }
+        }
         for (rep = 0; rep < steps; ++rep) {
             st = pyins_step((pyins_core *)g_mem, &s, &out);
             if (st != PYINS_OK) {
@@ -64,7 +83,9 @@ int main(void) {
             pyins_get_output((pyins_core *)g_mem, &out);   /* the command after the reset */
         }
         /* ideal table: the encoder reads the commanded angle, wrapped */
-        enc = out.table_angle_cmd_rad;
+        cmd_prev = cmd;
+        cmd = out.table_angle_cmd_rad;
+        enc = cmd;
         while (enc >= 6.283185307179586) enc -= 6.283185307179586;
         while (enc < 0.0) enc += 6.283185307179586;
         if ((k + 1u) % DEMO_PRINT_EVERY == 0u) {
@@ -74,6 +95,11 @@ int main(void) {
                    (unsigned long)out.n_seq_gaps, (unsigned long)out.n_seq_bridged,
                    (unsigned long)out.n_seq_repeats, (unsigned long)out.n_seq_lost,
                    (unsigned long)out.n_encoder_jumps);
+            /* at sea: mode in effect, references in use, used/rejected GNSS pos, vel and log */
+            printf(" %ld/%lx/%lu/%lu/%lu/%lu/%lu/%lu", (long)out.nav_mode, (unsigned long)out.ref_in_use,
+                   (unsigned long)out.n_ref_used[0], (unsigned long)out.n_ref_rejected[0],
+                   (unsigned long)out.n_ref_used[1], (unsigned long)out.n_ref_rejected[1],
+                   (unsigned long)out.n_ref_used[2], (unsigned long)out.n_ref_rejected[2]);
             put_hex(out.lat_rad);
             put_hex(out.lon_rad);
             put_hex(out.vel_n_mps[0]);
@@ -85,6 +111,9 @@ int main(void) {
             put_hex(out.kf_x[2]);
             put_hex(out.table_angle_cmd_rad);
             put_hex(out.index_a_c);
+            put_hex(out.nav_sigma_pos_m);
+            put_hex(out.nav_gyro_bias_rad_s[0]);
+            put_hex(out.nav_nis[0]);
             printf("\n");
         }
     }

@@ -53,13 +53,17 @@ static double lcg_unit(uint64_t *state) {
     return (double)((int64_t)(*state >> 43) - (int64_t)(1 << 20));
 }
 
-void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, pyins_sample *s) {
+void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, double table_step_rad, pyins_sample *s) {
     const int fault = demo_fault(k);
     const double k_ang = 1.0 / 1099511627776.0 / 1048576.0;  /* 2^-60 rad per LCG unit */
     const double k_vel = 1.0 / 1073741824.0 / 1048576.0;     /* 2^-50 m/s per LCG unit */
+    /* the IMU turns with the table: its z increment gains the table's step,
+       and the Earth rate's north component reads -1 x at the 180 deg stop
+       (nearer pi than 0; exact; off during a move only) */
+    const double side = encoder_rad > 1.5707963267948966 && encoder_rad < 4.71238898038469 ? -1.0 : 1.0;
     s->dtheta_p_rad[0] = lcg_unit(state) * k_ang;
-    s->dtheta_p_rad[1] = kDthetaN + lcg_unit(state) * k_ang;
-    s->dtheta_p_rad[2] = kDthetaU + lcg_unit(state) * k_ang;
+    s->dtheta_p_rad[1] = side * kDthetaN + lcg_unit(state) * k_ang;
+    s->dtheta_p_rad[2] = kDthetaU + table_step_rad + lcg_unit(state) * k_ang;
     s->dv_p_mps[0] = lcg_unit(state) * k_vel;
     s->dv_p_mps[1] = lcg_unit(state) * k_vel;
     /* heave: a zero-mean sawtooth acceleration of period 8 s (800 ticks),
@@ -76,4 +80,54 @@ void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, pyins_sample *
     } else if (fault == DEMO_ENCODER_GLITCH) {
         s->table_angle_rad = encoder_rad + 0.25;   /* 14 deg: beyond index_jump_rad (5 deg) */
     }
+}
+
+/* Navigation starts at tick 12000 (coarse 6000 + fine 6000 ticks). */
+#define DEMO_NAV_TICK 12000u
+#define DEMO_GNSS_END 18500u      /* the last GNSS second */
+#define DEMO_OUTLIER_TICK 16500u  /* a multipath jump of 1e-4 rad (637 m) north */
+#define DEMO_LOG_TICK 14000u      /* the speed log from here on */
+
+static void demo_ref(pyins_ref *r, int32_t kind, int64_t tick, double v0, double v1, double v2,
+                     double s0, double s1, double s2) {
+    memset(r, 0, sizeof *r);
+    r->kind = kind;
+    r->tick = tick;
+    r->value[0] = v0;
+    r->value[1] = v1;
+    r->value[2] = v2;
+    r->sigma[0] = s0;
+    r->sigma[1] = s1;
+    r->sigma[2] = s2;
+}
+
+int demo_refs(uint64_t *lcg, uint32_t k, pyins_ref *refs) {
+    /* the references' own noise (a receiver never repeats a fix bit for bit:
+       the core reads that as frozen), exact multiples of powers of two */
+    const double k_pos = 1.0 / 1099511627776.0;     /* 2^-40 rad per unit: up to 6 m */
+    const double k_vel = 1.0 / 16777216.0;          /* 2^-24 m/s per unit: up to 0.0625 m/s */
+    const uint32_t t = k + 1u;     /* the tick sample k ends */
+    int n = 0;
+    if (t <= DEMO_NAV_TICK + 100u) return 0;
+    if (t % 100u == 0u && t <= DEMO_GNSS_END) {
+        /* the velocity of second t, pushed ahead: queued, applied at its tick */
+        const double ve = lcg_unit(lcg) * k_vel;
+        const double vn = lcg_unit(lcg) * k_vel;
+        demo_ref(&refs[n++], PYINS_REF_GNSS_VEL, (int64_t)t, ve, vn, 0.0, 0.0625, 0.0625, 0.0625);
+    }
+    if (t % 100u == 20u && t <= DEMO_GNSS_END + 20u) {
+        /* the fix of 20 ticks ago, pushed late: carried forward by the velocity */
+        const uint32_t tf = t - 20u;
+        const double dlat = (tf == DEMO_OUTLIER_TICK ? 1e-4 : 0.0) + lcg_unit(lcg) * k_pos;
+        const double dlon = lcg_unit(lcg) * k_pos;
+        demo_ref(&refs[n++], PYINS_REF_GNSS_POS, (int64_t)tf, 0.5977054556379782 + dlat,
+                 1.9008380883470242 + dlon, 0.0, 3.0, 3.0, 5.0);
+    }
+    if (t % 100u == 50u && t > DEMO_LOG_TICK) {
+        /* moored: the log reads no speed through water, and its noise; it
+           learns the current under GNSS and damps alone after it */
+        demo_ref(&refs[n++], PYINS_REF_SPEED_LOG, (int64_t)t, lcg_unit(lcg) * k_vel, 0.0, 0.0, 0.0625, 0.0,
+                 0.0);
+    }
+    return n;
 }

@@ -6,9 +6,16 @@
  * point (lever arm, sensor offset), 60 s of moving-base coarse alignment
  * (FIT), 60 s of moving-base fine alignment (12 states), then
  * navigation with the traditional two-position scheme (20 s stops) on an
- * ideal table that reads back the previous command. The IMU counts its
+ * ideal table that reads back the previous command, the IMU turning with
+ * it (the Earth rate's sign at the 180 deg stop exact, approximate only in
+ * a move). The IMU counts its
  * samples (seq checking on), and a fixed schedule of sample-level faults
- * (demo_fault) runs every fault path of docs/core.md on every target. */
+ * (demo_fault) runs every fault path of docs/core.md on every target.
+ * In navigation the ship gets external references (demo_refs): GNSS
+ * position (0.2 s late) and velocity at 1 Hz, with one 600 m outlier the
+ * gate rejects (INTEGRATED), then the EM speed log alone (DAMPED after its
+ * 10 s of straight course), so the integrated filter, the gate, the
+ * latency compensation and the damping run on every target too. */
 #ifndef PYINS_DEMO_SCENARIO_H
 #define PYINS_DEMO_SCENARIO_H
 
@@ -37,8 +44,15 @@ void demo_config(pyins_config *cfg);
 /* The fault schedule: enum demo_fault_kind of sample k (0-based). */
 int demo_fault(uint32_t k);
 /* The sample of tick k (0-based), seq = k + 1, with demo_fault(k)'s content
- * fault applied; state is the LCG state (start at 1). */
-void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, pyins_sample *s);
+ * fault applied; state is the LCG state (start at 1); table_step_rad the
+ * table's turn over the tick (the IMU turns with it). */
+void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, double table_step_rad, pyins_sample *s);
+
+/* The references to push before stepping sample k (0-based): writes up to
+ * DEMO_MAX_REFS into refs and returns how many; state is their noise's LCG
+ * (start at 12345, apart from the samples'). */
+#define DEMO_MAX_REFS 2
+int demo_refs(uint64_t *state, uint32_t k, pyins_ref *refs);
 
 #ifdef __cplusplus
 }
