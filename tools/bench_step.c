@@ -1,7 +1,8 @@
 /* bench_step.c: drive the firmware for instruction counting.
  *   valgrind --tool=callgrind --toggle-collect=pyins_step ./bench_step 10000 [MODE [API]]
  * counts the instructions inside one API function only (repeatable, unlike
- * time). MODE: nav (default), navix, coarse, fine5, fine8, fit, fine12: every
+ * time). MODE: nav (default), navix, coarse, fine5, fine8, fit, fine12, navund,
+ * navgnss, navlog: every
  * step in that mode (csrc/embedded/bench_modes.h: the same scenarios as the
  * Cortex-M bench image). API, how the caller takes the records (toggle
  * callgrind on the function named):
@@ -60,6 +61,12 @@ int main(int argc, char **argv) {
     memset(&out, 0, sizeof out);
     if (api == API_STEP) {
         for (i = 0; i < n; ++i) {
+            pyins_ref refs[2];
+            const int n_refs = bench_refs(mode, i, refs);
+            int r;
+            for (r = 0; r < n_refs; ++r) {
+                if (pyins_push_ref((pyins_core *)mem, &refs[r]) != PYINS_OK) return 6;
+            }
             bench_sample(mode, i, out.table_angle_cmd_rad, &s);
             if (pyins_step((pyins_core *)mem, &s, &out) != PYINS_OK) return 4;
         }
@@ -69,7 +76,15 @@ int main(int argc, char **argv) {
             size_t done = 0, n_out = 0;
             long k;
             int st;
-            for (k = 0; k < m; ++k) bench_sample(mode, i + k, out.table_angle_cmd_rad, &block[k]);
+            for (k = 0; k < m; ++k) {
+                pyins_ref refs[2];
+                const int n_refs = bench_refs(mode, i + k, refs);
+                int r;
+                for (r = 0; r < n_refs; ++r) {   /* at most 5 a block: the queue holds 8 */
+                    if (pyins_push_ref((pyins_core *)mem, &refs[r]) != PYINS_OK) return 6;
+                }
+                bench_sample(mode, i + k, out.table_angle_cmd_rad, &block[k]);
+            }
             if (api == API_COMPACT) {
                 st = pyins_run_nav((pyins_core *)mem, block, (size_t)m, 1, navs, BLOCK + 1, &done, &n_out);
             } else if (api == API_EVERY100) {
@@ -82,6 +97,7 @@ int main(int argc, char **argv) {
             pyins_get_output((const pyins_core *)mem, &out);
         }
     }
-    printf("ticks %ld lat %.17g mode %d index_state %d\n", n, out.lat_rad, (int)out.mode, (int)out.index_state);
+    printf("ticks %ld lat %.17g mode %d index_state %d nav_mode %d used %u/%u/%u\n", n, out.lat_rad, (int)out.mode,
+           (int)out.index_state, (int)out.nav_mode, out.n_ref_used[0], out.n_ref_used[1], out.n_ref_used[2]);
     return 0;
 }

@@ -48,7 +48,8 @@ import stack_depth  # noqa: E402
 from pyins import native  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "nav_null", "nav_compact")
+MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "navund", "navgnss", "navlog", "nav_null",
+         "nav_compact")
 #: the rows that are the "nav" scenario through another API (bench_step's API argument and
 #: the function callgrind counts): no record, a compact record every tick
 API_OF = {"nav_null": ("nav", "null", "pyins_run"), "nav_compact": ("nav", "compact", "pyins_run_nav")}

@@ -50,6 +50,15 @@ int main(void) {
         for (i = 0; i < BENCH_TICKS; ++i) {
             uint32_t c;
             int st;
+            pyins_ref refs[2];
+            const int n_refs = bench_refs(m, i, refs);
+            int r;
+            for (r = 0; r < n_refs; ++r) {
+                if (pyins_push_ref((pyins_core *)g_mem, &refs[r]) != PYINS_OK) {
+                    printf("FAIL push %s %ld\n", bench_mode_name[m], i);
+                    return 5;
+                }
+            }
             bench_sample(m, i, out.table_angle_cmd_rad, &s);
             t0 = SYST_CVR;
             st = pyins_step((pyins_core *)g_mem, &s, &out);
@@ -65,8 +74,10 @@ int main(void) {
                 worst_tick = i;
             }
         }
-        printf("MODE %s ticks %d sum %lu max %lu maxtick %ld mode %ld\n", bench_mode_name[m], BENCH_TICKS,
-               (unsigned long)sum, (unsigned long)worst, worst_tick, (long)out.mode);
+        printf("MODE %s ticks %d sum %lu max %lu maxtick %ld mode %ld nav_mode %ld used %lu/%lu/%lu\n",
+               bench_mode_name[m], BENCH_TICKS, (unsigned long)sum, (unsigned long)worst, worst_tick,
+               (long)out.mode, (long)out.nav_mode, (unsigned long)out.n_ref_used[0],
+               (unsigned long)out.n_ref_used[1], (unsigned long)out.n_ref_used[2]);
     }
     /* The navigation scenario again, as a firmware that reads the motor
      * command every tick takes it: no record (pyins_run with outputs NULL,

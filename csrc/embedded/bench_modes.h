@@ -12,7 +12,16 @@
  *   fine8   FINE_ALIGN, 8-state filter
  *   fit     COARSE_ALIGN by FIT (moving base), a 2 m lever arm
  *   fine12  FINE_ALIGN, the moving-base 12-state filter (1 Hz updates), lever arm
- * The IMU swings gently, so every branch of a moving step runs. */
+ *   navund  NAVIGATE, nav_mode UNDAMPED: the strapdown alone, no filter at sea
+ *   navgnss NAVIGATE, INTEGRATED: GNSS position and velocity at 1 Hz (pushed
+ *           ahead, applied inside the step of their tick), every one used
+ *           (the gate opened: the scenario's IMU is not a ship at rest, and
+ *           the count wants the updates)
+ *   navlog  NAVIGATE, the EM speed log alone at 5 Hz: the current learnt
+ *           from its first 60 readings (12 s), DAMPED after 10 s of course
+ * The IMU swings gently, so every branch of a moving step runs. The
+ * references (bench_refs) are pushed before the step, outside the count
+ * (pyins_push_ref only queues them). */
 #ifndef PYINS_BENCH_MODES_H
 #define PYINS_BENCH_MODES_H
 
@@ -21,10 +30,10 @@
 #include "pyins_core.h"
 
 enum { BENCH_NAV, BENCH_NAVIX, BENCH_COARSE, BENCH_FINE5, BENCH_FINE8, BENCH_FIT, BENCH_FINE12,
-       BENCH_N_MODES };
+       BENCH_NAVUND, BENCH_NAVGNSS, BENCH_NAVLOG, BENCH_N_MODES };
 
 static const char *const bench_mode_name[BENCH_N_MODES] = {"nav", "navix", "coarse", "fine5", "fine8",
-                                                           "fit", "fine12"};
+                                                           "fit", "fine12", "navund", "navgnss", "navlog"};
 
 /* The mode called name, or -1. */
 static int bench_mode_of(const char *name) {
@@ -72,9 +81,47 @@ static int bench_config(int m, long n, pyins_config *cfg) {
             cfg->lever_b_m[1] = 1.5;
             cfg->lever_b_m[2] = 1.2;
             return 0;
+        case BENCH_NAVUND:
+            cfg->nav_mode = PYINS_NAV_UNDAMPED;
+            return 0;
+        case BENCH_NAVGNSS:
+            cfg->nav_gate = 1e30;
+            return 0;
+        case BENCH_NAVLOG:
+            return 0;
         default:
             return -1;
     }
+}
+
+/* The references to push before sample i (0-based) of mode m, valid at the
+ * end of its tick i + 1: up to 2 into refs; returns how many. Their values
+ * vary (a repeat bit for bit reads as a frozen receiver). */
+static int bench_refs(int m, long i, pyins_ref *refs) {
+    const long t = i + 1;
+    const double wiggle = (double)(t % 700) * 1e-3;
+    int n = 0;
+    memset(refs, 0, 2 * sizeof *refs);
+    if (m == BENCH_NAVGNSS && t % 100 == 0) {
+        refs[n].kind = PYINS_REF_GNSS_POS;
+        refs[n].tick = t;
+        refs[n].value[0] = 0.6 + wiggle * 1e-7;
+        refs[n].value[1] = 0.0;
+        refs[n].sigma[0] = refs[n].sigma[1] = refs[n].sigma[2] = 3.0;
+        ++n;
+        refs[n].kind = PYINS_REF_GNSS_VEL;
+        refs[n].tick = t;
+        refs[n].value[0] = wiggle;
+        refs[n].sigma[0] = refs[n].sigma[1] = refs[n].sigma[2] = 0.05;
+        ++n;
+    } else if (m == BENCH_NAVLOG && t % 20 == 0) {
+        refs[n].kind = PYINS_REF_SPEED_LOG;
+        refs[n].tick = t;
+        refs[n].value[0] = wiggle;
+        refs[n].sigma[0] = 0.05;
+        ++n;
+    }
+    return n;
 }
 
 /* Sample i (0-based); table_cmd_rad: the last output's commanded table
