@@ -172,15 +172,18 @@ class BlockFeed:
     (samples from the firmware's current tick on) with the references whose
     ticks fall in it, each pushed as `Aider` pushes it; `summary` says what
     was given, used, rejected and not used, and what the references do not
-    cover."""
+    cover. ``sources``: what each file gave (dicts, kept in the summary's
+    ``sources``); ``notes``: what reading them found (warnings, kept first
+    in the summary's)."""
 
-    def __init__(self, refs=None, zero_velocity_mps=None, zv_from_tick=0, tick_hz=100):
+    def __init__(self, refs=None, zero_velocity_mps=None, zv_from_tick=0, tick_hz=100, sources=(), notes=()):
         self.refs = contract.check_refs(refs) if refs is not None else np.zeros(0, dtype=contract.REF_DTYPE)
         if self.refs.shape[0] and np.any(np.diff(self.refs["tick"]) < 0):
             raise ValueError("refs: ticks must not decrease")
         if zero_velocity_mps is not None and not (np.isfinite(zero_velocity_mps) and zero_velocity_mps > 0):
             raise ValueError(f"zero_velocity_mps: {zero_velocity_mps!r} must be a sigma > 0 [m/s]")
         self.zv_sigma, self.zv_from, self.hz = zero_velocity_mps, int(zv_from_tick), int(tick_hz)
+        self.sources, self.notes = [dict(s) for s in sources], [str(n) for n in notes]
         self.pushed = 0        # references handed to the firmware
         self.zv_given = 0
         self.end_tick = 0      # the firmware's tick after the last block
@@ -227,7 +230,7 @@ class BlockFeed:
         if self.zv_given:
             given[contract.REF_KINDS["zero_velocity"]] = given.get(contract.REF_KINDS["zero_velocity"], 0) \
                 + self.zv_given
-        kinds, warn = {}, []
+        kinds, warn = {}, list(self.notes)
         for k, n in sorted(given.items()):
             s = k - 1
             kinds[from_names[k]] = dict(given=n, used=int(last["n_ref_used"][s]),
@@ -236,6 +239,8 @@ class BlockFeed:
                                         after_end=int(np.count_nonzero((self.refs["kind"] == k)
                                                                        & (self.refs["tick"] > self.end_tick))))
         facts = dict(kinds=kinds)
+        if self.sources:
+            facts["sources"] = self.sources
         if self.zv_sigma is not None:
             facts["zero_velocity_mps"] = self.zv_sigma
         file_refs = len(self.refs)

@@ -11,6 +11,7 @@ import zipfile
 import numpy as np
 
 from pyins import aiding, engine, logs, replay, replay_options, report, scenario, truth_track
+from pyins.logs import nmea as nmea_files
 from pyins.sim import references as reference_files
 from pyins.reference import abi
 from pyins.report import replay as report_replay
@@ -80,6 +81,25 @@ def add_replay(cmd):
                    help="external references used in navigation (GNSS position and velocity, EM speed "
                         "log, zero velocity), ticks on the log's clock (tick T: the end of its T-th sample): the text layout "
                         "'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, \"Reference files\")")
+    p.add_argument("--gnss", metavar="FILE",
+                   help="GNSS fixes used in navigation: an NMEA 0183 file (GGA position, RMC or VTG velocity, "
+                        "GST sigmas; needs --nmea-utc-start) or the --refs layout with gnss_pos/gnss_vel rows "
+                        "(docs/log-formats.md, \"NMEA 0183\")")
+    p.add_argument("--speed-log", metavar="FILE",
+                   help="EM speed log used in navigation: an NMEA 0183 file (VHW or VBW water speed; needs "
+                        "--nmea-utc-start) or the --refs layout with speed_log rows")
+    p.add_argument("--nmea-utc-start", metavar="UTC",
+                   help="the UTC date and time of the log's start (tick 0), e.g. 2026-12-05T10:00:00.00: "
+                        "maps the NMEA files' UTC times onto the log's ticks")
+    p.add_argument("--gnss-sigma", metavar="SIGMA",
+                   help="position sigma (east, north, up) of an NMEA fix without a GST of its epoch, e.g. "
+                        f"'3 m' (default '{nmea_files.DEFAULT_POS_SIGMA_M:g} m', assumed: said in a warning)")
+    p.add_argument("--gnss-vel-sigma", metavar="SIGMA",
+                   help="sigma per axis of an NMEA velocity (RMC, VTG carry none), e.g. '0.05 m/s' "
+                        f"(default '{nmea_files.DEFAULT_VEL_SIGMA_MPS:g} m/s', assumed: said in a warning)")
+    p.add_argument("--speed-log-sigma", metavar="SIGMA",
+                   help="sigma of an NMEA speed-log speed (VHW, VBW carry none), e.g. '0.05 m/s' "
+                        f"(default '{nmea_files.DEFAULT_LOG_SIGMA_MPS:g} m/s', assumed: said in a warning)")
     p.add_argument("--zero-velocity", nargs="?", const="0.01 m/s", metavar="SIGMA",
                    help="the vehicle or ship at rest after its alignment: a zero-velocity reference every "
                         "second of navigation, SIGMA per axis (default '0.01 m/s')")
@@ -184,8 +204,45 @@ def _spool(log, fmt):
     return tmp, fmt, tmp
 
 
+#: the sigma options of the NMEA files: (option, attribute, dimension, unit, the file's option)
+_SIGMAS = (("--gnss-sigma", "gnss_sigma", "length", "m", "--gnss"),
+           ("--gnss-vel-sigma", "gnss_vel_sigma", "velocity", "m/s", "--gnss"),
+           ("--speed-log-sigma", "speed_log_sigma", "velocity", "m/s", "--speed-log"))
+
+
+def _check_reference_options(args):
+    """The options of the reference files, refused when they cannot be
+    right or apply to nothing given (one line each); the sigmas in SI and
+    the start in ns are kept on ``args`` (``_sigmas``, ``_utc_start``)."""
+    files = {"--gnss": args.gnss, "--speed-log": args.speed_log}
+    args._sigmas = {}
+    for option, attr, dimension, unit, owner in _SIGMAS:
+        text = getattr(args, attr)
+        if text is None:
+            continue
+        if files[owner] is None:
+            raise InputError(f"{option}: applies to the NMEA file of {owner} FILE, which is not given")
+        try:
+            value = replay_options.quantity(option, text, dimension)
+        except ValueError as exc:
+            raise InputError(str(exc)) from None
+        if not (np.isfinite(value) and value > 0.0):
+            raise InputError(f"{option} {text!r}: a sigma must be more than 0 {unit}")
+        args._sigmas[option] = value
+    args._utc_start = None
+    if args.nmea_utc_start is not None:
+        if args.gnss is None and args.speed_log is None:
+            raise InputError("--nmea-utc-start: applies to the NMEA files of --gnss or --speed-log; neither "
+                             "is given")
+        try:
+            args._utc_start = nmea_files.parse_utc(args.nmea_utc_start)
+        except ValueError as exc:
+            raise InputError(f"--nmea-utc-start: {exc}") from None
+
+
 def cmd_replay(args):
     _check_reader_options(args)
+    _check_reference_options(args)
     path, fmt, spooled = _spool(args.log, args.format)
     try:
         return _replay(args, path, fmt)
@@ -201,17 +258,124 @@ def cmd_replay(args):
             os.remove(spooled)
 
 
+def _refs_csv(option, path):
+    """A file of the reference text layout (`load_refs_csv`), or InputError
+    naming ``option``."""
+    try:
+        return reference_files.load_refs_csv(path)
+    except OSError as exc:
+        raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{option} {path}: not a text file of references (bytes that are not "
+                         "ASCII); the layout is in docs/log-formats.md, \"Reference files\"") from None
+    except ValueError as exc:
+        raise InputError(f"{option} {exc}") from None
+
+
+def _row_line(path, index):
+    """The line number of the ``index``-th record of a reference text file
+    (its header is line 1; blank lines are skipped)."""
+    with open(path, encoding="ascii") as f:
+        n = -1
+        for lineno, line in enumerate(f, 1):
+            if lineno == 1 or not line.strip():
+                continue
+            n += 1
+            if n == index:
+                return lineno
+    return None
+
+
+#: the kinds each file option takes, and the option for the others
+_FILE_KINDS = {"--gnss": ("gnss_pos", "gnss_vel"), "--speed-log": ("speed_log",)}
+
+
+def _reference_file(args, option, path, hz):
+    """The references of ``--gnss FILE`` or ``--speed-log FILE`` (NMEA 0183
+    or the reference text layout, restricted to the option's kinds):
+    (records, what the file gave, warnings); InputError when refused."""
+    kinds = _FILE_KINDS[option]
+    try:
+        if os.path.isdir(path):
+            raise InputError(f"{option} {path}: a directory, not a file of references")
+        if os.path.getsize(path) == 0:
+            raise InputError(f"{option} {path}: an empty file")
+        nmea = nmea_files.is_nmea(path)
+    except OSError as exc:
+        raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
+    if nmea:
+        if args._utc_start is None:
+            raise InputError(f"{option} {path}: an NMEA 0183 file, whose times are UTC: give --nmea-utc-start, "
+                             "the UTC date and time of the log's start (tick 0), e.g. "
+                             "--nmea-utc-start 2026-12-05T10:00:00.00")
+        sig = args._sigmas
+        try:
+            got = nmea_files.read_nmea(
+                path, args._utc_start, hz, kinds, pos_sigma_m=sig.get("--gnss-sigma"),
+                vel_sigma_mps=sig.get("--gnss-vel-sigma"), log_sigma_mps=sig.get("--speed-log-sigma"),
+                name=f"{option} {path}",
+                option_names=dict(utc_start="--nmea-utc-start", pos_sigma="--gnss-sigma",
+                                  vel_sigma="--gnss-vel-sigma", log_sigma="--speed-log-sigma"))
+        except OSError as exc:
+            raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
+        except nmea_files.NmeaError as exc:
+            raise InputError(str(exc)) from None
+        return got.refs, dict(option=option, file=path, **got.facts), got.warnings
+    for sigma_option, _, _, _, owner in _SIGMAS:
+        if owner == option and sigma_option in args._sigmas:
+            raise InputError(f"{sigma_option}: {option} {path} is in the reference text layout, whose rows hold "
+                             f"their sigmas (only an NMEA file takes {sigma_option}): drop it")
+    try:
+        with open(path, encoding="ascii") as f:
+            head = f.readline().strip()
+    except UnicodeDecodeError:
+        head = None
+    except OSError as exc:
+        raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
+    if head != reference_files.CSV_HEADER:
+        comp = logs.compression_of(path)
+        what = (f"a {comp}-compressed file whose text is not NMEA 0183 (the reference text layout is read "
+                "uncompressed)" if comp else "bytes that are not ASCII text" if head is None else None)
+        raise InputError(f"{option} {path}:1: neither NMEA 0183 (sentences beginning with $ or !) nor the "
+                         f"reference text layout (its header {reference_files.CSV_HEADER!r}; docs/log-formats.md, "
+                         "\"Reference files\")" + (f": {what}" if what else ""))
+    refs = _refs_csv(option, path)
+    if not len(refs):
+        raise InputError(f"{option} {path}: holds no reference (only its header)")
+    names = np.array([reference_files.KIND_NAMES.get(int(k), "?") for k in refs["kind"]])
+    wrong = np.flatnonzero(~np.isin(names, kinds))
+    if len(wrong):
+        i = int(wrong[0])
+        other = {"speed_log": "--speed-log or --refs", "gnss_pos": "--gnss or --refs",
+                 "gnss_vel": "--gnss or --refs"}.get(names[i], "--refs")
+        raise InputError(f"{option} {path}:{_row_line(path, i)}: a {names[i]} reference; {option} takes "
+                         f"{' and '.join(kinds)} ({len(wrong)} rows are not): give the file to {other}")
+    counts = {k: int(np.count_nonzero(names == k)) for k in kinds if np.any(names == k)}
+    return refs, dict(option=option, file=path, format="reference text", references=counts), []
+
+
 def _feed(args, cfg, hz):
-    """The external references of --refs and --zero-velocity (a
-    `pyins.aiding.BlockFeed`), or None; refused before the log runs when
-    they cannot be used."""
-    if args.refs is None and args.zero_velocity is None:
+    """The external references of --refs, --gnss, --speed-log and
+    --zero-velocity (a `pyins.aiding.BlockFeed`), or None; refused before
+    the log runs when they cannot be used. The files' records are merged
+    by tick (stable: --refs, --gnss, --speed-log at one tick)."""
+    given = [o for o, v in (("--refs", args.refs), ("--gnss", args.gnss), ("--speed-log", args.speed_log),
+                            ("--zero-velocity", args.zero_velocity)) if v is not None]
+    if not given:
         return None
     if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
-        raise InputError("--refs/--zero-velocity: the scenario sets firmware.nav_mode = \"undamped\", "
+        raise InputError(f"{'/'.join(given)}: the scenario sets firmware.nav_mode = \"undamped\", "
                          "which takes no references")
     refs = zv = None
+    parts, sources, notes = [], [], []
     if args.refs is not None:
+        try:
+            nmea = nmea_files.is_nmea(args.refs)
+        except OSError:
+            nmea = False         # said below, as load_refs_csv finds it
+        if nmea:
+            raise InputError(f"--refs {args.refs}: an NMEA 0183 file: give it to --gnss (GGA, RMC, VTG) or "
+                             "--speed-log (VHW, VBW), with --nmea-utc-start")
         try:
             refs = reference_files.load_refs_csv(args.refs)
         except OSError as exc:
@@ -226,12 +390,27 @@ def _feed(args, cfg, hz):
         if unused:
             raise InputError(f"--refs {args.refs}: {', '.join(unused)} references are not used by this "
                              "firmware yet (it takes gnss_pos, gnss_vel, speed_log and zero_velocity)")
+        parts.append(refs)
+    for option, path in (("--gnss", args.gnss), ("--speed-log", args.speed_log)):
+        if path is not None:
+            r, source, said = _reference_file(args, option, path, hz)
+            parts.append(r)
+            sources.append(source)
+            notes.extend(said)
+    if args._utc_start is not None and not any(s.get("format") == "NMEA 0183" for s in sources):
+        raise InputError("--nmea-utc-start: applies to NMEA files; "
+                         + " and ".join(f"{s['option']} {s['file']}" for s in sources)
+                         + " " + ("is" if len(sources) == 1 else "are") + " in the reference text layout, "
+                         "whose ticks are on the log's clock already: drop it")
+    if parts:
+        refs = np.concatenate(parts) if len(parts) > 1 else parts[0]
+        refs = refs[np.argsort(refs["tick"], kind="stable")]
     if args.zero_velocity is not None:
         zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
         if not (np.isfinite(zv) and zv > 0.0):
             raise InputError(f"--zero-velocity {args.zero_velocity!r}: a sigma must be more than 0 m/s")
     zv_from = cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
-    return aiding.BlockFeed(refs, zv, zv_from, hz)
+    return aiding.BlockFeed(refs, zv, zv_from, hz, sources=sources, notes=notes)
 
 
 def _replay(args, path, fmt):
@@ -316,6 +495,8 @@ def _replay(args, path, fmt):
     mode = report_replay.MODES.get(fin["mode"], f"mode {fin['mode']}")
     say(args, f"  final position {fin['lat_deg']:.6f} N {fin['lon_deg']:.6f} E, {mode}, "
                f"faults {', '.join(faults) or 'none'}")
+    for src in summary.get("references", {}).get("sources", ()):
+        say(args, "  " + report_replay.source_text(src))
     for name, k in summary.get("references", {}).get("kinds", {}).items():
         say(args, f"  references {name}: {k['given']} given, {k['used']} used, {k['rejected']} rejected by "
                    f"the gate" + (f", {k['stale']} repeats unused" if k["stale"] else "")

@@ -32,7 +32,7 @@ from pyins.reference.fine_align import EPS, EPS_NU, PHI
 from pyins.report.plotting import MAX_POINTS, envelope, line, pyplot, time_axis
 from pyins.units import ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
 
-__all__ = ["render", "is_replay"]
+__all__ = ["render", "is_replay", "source_text"]
 
 MODES = {abi.PYINS_MODE_IDLE: "idle", abi.PYINS_MODE_COARSE_ALIGN: "coarse alignment",
           abi.PYINS_MODE_FINE_ALIGN: "fine alignment", abi.PYINS_MODE_NAVIGATE: "navigation"}
@@ -157,6 +157,20 @@ def alignment_figures(rec, end=None):
 
 def _row(name, value):
     return f"<tr><th>{html.escape(name)}</th><td>{html.escape(str(value))}</td></tr>"
+
+
+def source_text(src):
+    """What one reference file gave (an entry of the summary's
+    ``references.sources``), in one line: the terminal's and the page's."""
+    head = f"{src.get('option', '')} {src.get('file', '')}".strip()
+    if src.get("format") != "NMEA 0183":
+        return f"{head}: " + ", ".join(f"{n} {k}" for k, n in src.get("references", {}).items())
+    got = []
+    for k, n in src.get("references", {}).items():
+        sig = ", ".join(f"{m} {w}" for w, m in src.get("sigmas", {}).get(k, {}).items() if m)
+        got.append(f"{n} {k} from {src.get('sentences_used', {}).get(k, '?')}" + (f" (sigma: {sig})" if sig else ""))
+    span = src.get("utc_span") or ["?", "?"]
+    return f"{head} (NMEA 0183, UTC {span[0]} .. {span[1]}): {', '.join(got) or 'no reference in the log'}"
 
 
 #: records read at a time (3.5 MB at 432 B): small against the process, so a
@@ -318,6 +332,8 @@ def render(out_dir):
     faults = abi.fault_names(fin["fault_flags"])
     rows.append(_row("final", f"{MODES.get(fin['mode'], fin['mode'])}; {fin['lat_deg']:.6f} N "
                               f"{fin['lon_deg']:.6f} E; faults: {', '.join(faults) or 'none'}"))
+    for src in (refs or {}).get("sources", ()):
+        rows.append(_row("reference file", source_text(src)))
     for name, k in (refs or {}).get("kinds", {}).items():
         rows.append(_row(f"references {name}",
                          f"{k['given']} given, {k['used']} used, {k['rejected']} rejected by the gate, "
