@@ -207,6 +207,13 @@ def _firmware_config(res, motion):
         # the accelerometers were there (initial_config would give it the motion's)
         cfg["lever_b_m"] = [0.0, 0.0, 0.0]
         cfg["lever_p_m"] = [0.0, 0.0, 0.0]
+    dvl = (res.get("references") or {}).get("dvl")
+    if dvl is not None:
+        # the DVL's mounting as the firmware is told it (only with a DVL: the
+        # configuration of a scenario without one is what it always was)
+        told = dvl["misalignment_told_rad"]
+        cfg["dvl_align_rad"] = list(dvl["misalignment_rad"] if told is None else told)
+        cfg["dvl_lever_b_m"] = list(dvl["lever_m"])
     for name, c_name in (("stop_s", "index_stop_ticks"), ("timeout_s", "index_timeout_ticks")):
         if ix[name] is not None:
             cfg[c_name] = _ticks(ix[name])
@@ -283,9 +290,9 @@ def _firmware_check(motion, cfg):
     status = engines.config_check(full)
     if status != 0:
         name = contract.status_str(status).split(":")[0]
-        raise ScenarioError(f"the firmware refuses the configuration: {contract.status_str(status)} "
-                            f"({limits.explain(status, full, _FIELD_KEYS)})",
-                            _STATUS_KEYS.get(name, "firmware"))
+        said = f"the firmware refuses the configuration: {contract.status_str(status)}"
+        why = limits.explain(status, full, _FIELD_KEYS)
+        raise ScenarioError(said if why == said else f"{said} ({why})", _STATUS_KEYS.get(name, "firmware"))
 
 
 # ---------------------------------------------------------------------------
@@ -313,8 +320,9 @@ class RunSpec:
 
 def _references(res, motion):
     """(refs, avail_tick) of the resolved [references]: the simulated GNSS
-    receiver's fixes and the zero-velocity declarations, merged by tick
-    (`pyins.sim.references`); (None, None) without any."""
+    receiver's fixes, the speed log's and the DVL's readings and the
+    zero-velocity declarations, merged by tick (`pyins.sim.references`);
+    (None, None) without any."""
     rt = res.get("references")
     if not rt:
         return None, None
@@ -341,6 +349,14 @@ def _references(res, motion):
                                    noise_mps=lg["noise_mps"], seed=lg["seed"], dt=DT)
         log.refs["sigma"][:, 0] = lg["sigma_mps"]      # what the firmware is told
         parts.append(log)
+    dv = rt.get("dvl")
+    if dv is not None:
+        # bottom track: the velocity over ground (no current), in the DVL's frame
+        d = references.dvl(motion, duration, None, misalignment_rad=dv["misalignment_rad"],
+                           scale_factor=dv["scale_factor"], noise_mps=dv["noise_mps"], rate_hz=dv["rate_hz"],
+                           lever_b=dv["lever_m"], seed=dv["seed"], dt=DT)
+        d.refs["sigma"] = dv["sigma_mps"]              # what the firmware is told
+        parts.append(d)
     z = rt.get("zero_velocity")
     if z is not None:
         fw = res["firmware"]

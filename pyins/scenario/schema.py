@@ -238,8 +238,9 @@ INDEXING_KEYS = {
 STEP_KEYS = {
     "stop": _time("stop before the move", required=True, lo="0.01 s", hi="1 d"),
     "move": Key("choice", "move kind", required=True, choices=tuple(_STEP_MOVES)),
+    # the firmware refuses a step beyond 8 turns, |angle| > 16 pi (config.cpp, PYINS_E_CONFIG_INDEX_STEP)
     "angle": _angle("fixed: the turn (signed, counter-clockwise +); flex_*: its sense", None,
-                    "-3600 deg", "3600 deg", required=True),
+                    "-2880 deg", "2880 deg", required=True),
 }
 
 #: the firmware's enums by the names scenario files and the CLI use
@@ -400,8 +401,28 @@ SPEED_LOG_KEYS = {
                              "reading misses)", "0.1 m/s", lo="0 m/s", hi="10 m/s", lo_open=True),
     "seed": Key("int", "seed of the log's noise (not the IMU's)", default=0, lo=0),
 }
+#: Keys of [references.dvl]: a Doppler velocity log in bottom track (the
+#: velocity over ground in its own frame; pyins.sim.references.dvl), a
+#: velocity reference of the firmware's filter.
+DVL_KEYS = {
+    "rate": Key("frequency", "readings per second (1 / rate a whole number of ticks)", "1 Hz", lo="0 Hz",
+                hi="100 Hz", lo_open=True),
+    "noise": Key("velocity", "white noise of a reading, per axis", "0.01 m/s", lo="0 m/s", hi="10 m/s"),
+    "scale_factor": Key("dimensionless", "scale factor error", 0.002, lo=-0.5, hi=0.5),
+    "misalignment": _angle("the DVL's mounting, a rotation vector m from the ship's axes: C_d^b = "
+                           "exp([m x]), [x, y, z]", "0 deg", "-180 deg", "180 deg", shape=3),
+    "misalignment_told": _angle("the mounting the firmware is told (its dvl_align_rad; default: the "
+                                "misalignment, a calibrated mounting; \"0 deg\": not told)", None,
+                                "-180 deg", "180 deg", shape=3),
+    "lever": Key("length", "reference point -> DVL [x starboard, y bow, z up], told to the firmware "
+                           "(its dvl_lever_b_m)", "0 m", lo="-100 m", hi="100 m", shape=3),
+    "sigma": Key("velocity", "the sigma per axis the firmware is told", "0.01 m/s", lo="0 m/s",
+                 hi="10 m/s", lo_open=True),
+    "seed": Key("int", "seed of the DVL's noise (not the IMU's)", default=0, lo=0),
+}
 #: [references] sub-tables -> their keys
-REFERENCE_TABLES = {"gnss": GNSS_KEYS, "speed_log": SPEED_LOG_KEYS, "zero_velocity": ZERO_VELOCITY_KEYS}
+REFERENCE_TABLES = {"gnss": GNSS_KEYS, "speed_log": SPEED_LOG_KEYS, "dvl": DVL_KEYS,
+                    "zero_velocity": ZERO_VELOCITY_KEYS}
 
 #: table name -> its keys (motion: the common keys; kinds add theirs).
 TABLES = {"motion": MOTION_COMMON, "sensors": SENSOR_KEYS, "turntable": TURNTABLE_KEYS,

@@ -490,6 +490,10 @@ MISTAKES = [
     ("missing duration", MOTION, "duration", "missing (required: ship time simulated)"),
     ("custom without steps", 'duration = "1 h"\n' + MOTION + '[indexing]\nscheme = "custom"\n'
      'rate = "6 deg/s"\nacceleration = "30 deg/s^2"\n', "indexing.steps", "missing (required with scheme"),
+    # the firmware refuses a step beyond 8 turns (16 pi): the file's key says so, not the firmware's status
+    ("step beyond 8 turns", 'duration = "1 h"\n' + MOTION + '[indexing]\nscheme = "custom"\nrate = "6 deg/s"\n'
+     'acceleration = "30 deg/s^2"\n[[indexing.steps]]\nstop = "1 s"\nmove = "fixed"\nangle = "2881 deg"\n',
+     "indexing.steps[0].angle", "must be >= -2880 deg and <= 2880 deg"),
     ("steps without custom", 'duration = "1 h"\n' + MOTION + '[indexing]\nscheme = "flexible"\n'
      '[[indexing.steps]]\nstop = "1 s"\nmove = "fixed"\nangle = "1 deg"\n', "indexing.steps",
      "steps are only used with scheme = 'custom'"),
