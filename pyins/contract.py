@@ -120,7 +120,8 @@ _STATUS_MEANING = {
     "PYINS_E_CONFIG_LON": "longitude must be finite and within +-720 deg",
     "PYINS_E_CONFIG_HEIGHT": "height must be finite and within -1e4..1e5 m",
     "PYINS_E_CONFIG_VEL": "velocity must be finite and below 1e4 m/s per axis",
-    "PYINS_E_CONFIG_ATT": "attitude angles and table angle must be finite",
+    "PYINS_E_CONFIG_ATT": "attitude angles, table angle and dvl_align_rad must be finite (dvl_align_rad at "
+                          "most pi long)",
     "PYINS_E_CONFIG_MODE": "vertical_mode must be PYINS_VERTICAL_HOLD or PYINS_VERTICAL_FREE",
     "PYINS_E_CONFIG_ALIGN_RATIO": "coarse_ratio must be in (0, 1) (0 = default 1/2)",
     "PYINS_E_CONFIG_ALIGN_EARLY": "first coarse output before enough data (coarse_ratio * first output "
@@ -148,7 +149,7 @@ _STATUS_MEANING = {
     "PYINS_E_CONFIG_SEQ": "seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 "
                           "(0 = default)",
     "PYINS_E_CONFIG_INDEX_SUMS": "index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL",
-    "PYINS_E_CONFIG_LEVER": "lever_b_m and lever_p_m must be finite and at most 100 m long",
+    "PYINS_E_CONFIG_LEVER": "lever_b_m, lever_p_m and dvl_lever_b_m must be finite and at most 100 m long",
     "PYINS_E_CONFIG_COARSE_METHOD": "coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or "
                                     "PYINS_COARSE_EQ8",
     "PYINS_E_CONFIG_INTEGRITY": "integrity_nis_window must be -1 (off), 0 (default) or positive, "
@@ -157,7 +158,8 @@ _STATUS_MEANING = {
                           "nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks "
                           "1..10 s (0 = default)",
     "PYINS_E_REF_KIND": "unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, "
-                        "SPEED_LOG, ZERO_VEL are used)",
+                        "SPEED_LOG, DVL bottom track, ZERO_VEL are used; a DVL with reserved != 0, water "
+                        "track, is not)",
     "PYINS_E_REF_VALUE": "a reference value is not finite (or a latitude beyond 90 deg), or its sigma is "
                          "not finite and > 0; refused, state unchanged",
     "PYINS_E_REF_ORDER": "a reference older than the last one pushed, or older than ref_max_latency_ticks "

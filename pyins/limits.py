@@ -61,6 +61,9 @@ def explain(status, cfg, names=None):
     if status == abi.PYINS_E_CONFIG_VEL:
         return f"{n('vel_n_mps')}: each component must be finite and within +-10 km/s"
     if status == abi.PYINS_E_CONFIG_ATT:
+        m = [float(x) for x in r["dvl_align_rad"]]
+        if not (all(math.isfinite(x) for x in m) and math.sqrt(sum(x * x for x in m)) <= math.pi):
+            return f"{n('dvl_align_rad')}: the DVL's mounting rotation must be finite and at most 180 deg long"
         return f"{n('euler_b_rad')}: the initial attitude and table angle must be finite"
     if status == abi.PYINS_E_CONFIG_ALIGN_TICKS:
         if r["coarse_ticks"] > 0 and first > r["coarse_ticks"]:

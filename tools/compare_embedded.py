@@ -44,6 +44,7 @@ def demo_fault(k):
 
 
 DEMO_NAV_TICK, DEMO_GNSS_END, DEMO_OUTLIER_TICK, DEMO_LOG_TICK = 12000, 18500, 16500, 14000
+DEMO_DVL_FROM, DEMO_DVL_TO = 20500, 22000
 K_POS = 1.0 / 1099511627776.0      # 2^-40 rad per LCG unit
 K_REF_VEL = 1.0 / 16777216.0       # 2^-24 m/s per LCG unit
 
@@ -66,6 +67,11 @@ def demo_refs(unit, k):
         refs.append((1, tf, (0.5977054556379782 + dlat, 1.9008380883470242 + dlon, 0.0), (3.0, 3.0, 5.0)))
     if t % 100 == 50 and t > DEMO_LOG_TICK:
         refs.append((3, t, (unit() * K_REF_VEL, 0.0, 0.0), (0.0625, 0.0, 0.0)))
+    if t % 100 == 70 and DEMO_DVL_FROM < t <= DEMO_DVL_TO:
+        vx = unit() * K_REF_VEL
+        vy = unit() * K_REF_VEL
+        vz = unit() * K_REF_VEL
+        refs.append((4, t, (vx, vy, vz), (0.0625, 0.0625, 0.0625)))
     return refs
 
 
@@ -75,7 +81,8 @@ def python_lines():
     cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
                fine_states=12, index_scheme=2, index_stop_ticks=2000, seq_mode=1,
                coarse_method=1, lever_b_m=[0.5, 1.5, 1.25], lever_p_m=[0.0625, 0.0, 0.0],
-               fine_site_accel=0.009765625)
+               fine_site_accel=0.009765625, dvl_align_rad=[0.0078125, -0.0078125, 0.5],
+               dvl_lever_b_m=[0.25, 2.0, -3.0])
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
     states = {"samples": 1, "refs": 12345}
@@ -149,7 +156,8 @@ def python_lines():
                                                             "n_encoder_jumps"))
             nav = "/".join(str(v) for v in (out.nav_mode, f"{out.ref_in_use:x}", out.n_ref_used[0],
                                             out.n_ref_rejected[0], out.n_ref_used[1], out.n_ref_rejected[1],
-                                            out.n_ref_used[2], out.n_ref_rejected[2]))
+                                            out.n_ref_used[2], out.n_ref_rejected[2], out.n_ref_used[3],
+                                            out.n_ref_rejected[3]))
             lines.append(f"{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {nav} "
                          f"{hexes}")
     lines.append("DONE")

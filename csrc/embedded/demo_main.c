@@ -95,11 +95,12 @@ int main(void) {
                    (unsigned long)out.n_seq_gaps, (unsigned long)out.n_seq_bridged,
                    (unsigned long)out.n_seq_repeats, (unsigned long)out.n_seq_lost,
                    (unsigned long)out.n_encoder_jumps);
-            /* at sea: mode in effect, references in use, used/rejected GNSS pos, vel and log */
-            printf(" %ld/%lx/%lu/%lu/%lu/%lu/%lu/%lu", (long)out.nav_mode, (unsigned long)out.ref_in_use,
+            /* at sea: mode in effect, references in use, used/rejected GNSS pos, vel, log and DVL */
+            printf(" %ld/%lx/%lu/%lu/%lu/%lu/%lu/%lu/%lu/%lu", (long)out.nav_mode, (unsigned long)out.ref_in_use,
                    (unsigned long)out.n_ref_used[0], (unsigned long)out.n_ref_rejected[0],
                    (unsigned long)out.n_ref_used[1], (unsigned long)out.n_ref_rejected[1],
-                   (unsigned long)out.n_ref_used[2], (unsigned long)out.n_ref_rejected[2]);
+                   (unsigned long)out.n_ref_used[2], (unsigned long)out.n_ref_rejected[2],
+                   (unsigned long)out.n_ref_used[3], (unsigned long)out.n_ref_rejected[3]);
             put_hex(out.lat_rad);
             put_hex(out.lon_rad);
             put_hex(out.vel_n_mps[0]);

@@ -33,6 +33,14 @@ void demo_config(pyins_config *cfg) {
     /* ranging on its lines: the site-motion model (moving_align.hpp), 1000 ug/sqrt(Hz)
        (a binary fraction near it, as the lever arms) */
     cfg->fine_site_accel = 0.009765625;
+    /* a DVL turned 28.6 deg about z and a little about x and y, 2 m forward
+       and 3 m down (exact binary fractions) */
+    cfg->dvl_align_rad[0] = 0.0078125;
+    cfg->dvl_align_rad[1] = -0.0078125;
+    cfg->dvl_align_rad[2] = 0.5;
+    cfg->dvl_lever_b_m[0] = 0.25;
+    cfg->dvl_lever_b_m[1] = 2.0;
+    cfg->dvl_lever_b_m[2] = -3.0;
 }
 
 int demo_fault(uint32_t k) {
@@ -87,6 +95,8 @@ void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, double table_s
 #define DEMO_GNSS_END 18500u      /* the last GNSS second */
 #define DEMO_OUTLIER_TICK 16500u  /* a multipath jump of 1e-4 rad (637 m) north */
 #define DEMO_LOG_TICK 14000u      /* the speed log from here on */
+#define DEMO_DVL_FROM 20500u      /* a DVL in bottom track over (from, to] */
+#define DEMO_DVL_TO 22000u
 
 static void demo_ref(pyins_ref *r, int32_t kind, int64_t tick, double v0, double v1, double v2,
                      double s0, double s1, double s2) {
@@ -128,6 +138,15 @@ int demo_refs(uint64_t *lcg, uint32_t k, pyins_ref *refs) {
            learns the current under GNSS and damps alone after it */
         demo_ref(&refs[n++], PYINS_REF_SPEED_LOG, (int64_t)t, lcg_unit(lcg) * k_vel, 0.0, 0.0, 0.0625, 0.0,
                  0.0);
+    }
+    if (t % 100u == 70u && t > DEMO_DVL_FROM && t <= DEMO_DVL_TO) {
+        /* moored: the DVL reads no velocity over ground, and its noise, in
+           its own axes (turned into n by the mounting, the lever arm's
+           w x r taken out) */
+        const double vx = lcg_unit(lcg) * k_vel;
+        const double vy = lcg_unit(lcg) * k_vel;
+        const double vz = lcg_unit(lcg) * k_vel;
+        demo_ref(&refs[n++], PYINS_REF_DVL, (int64_t)t, vx, vy, vz, 0.0625, 0.0625, 0.0625);
     }
     return n;
 }

@@ -14,8 +14,10 @@
  * In navigation the ship gets external references (demo_refs): GNSS
  * position (0.2 s late) and velocity at 1 Hz, with one 600 m outlier the
  * gate rejects (INTEGRATED), then the EM speed log alone (DAMPED after its
- * 10 s of straight course), so the integrated filter, the gate, the
- * latency compensation and the damping run on every target too. */
+ * 10 s of straight course), a DVL in bottom track for 15 s with a mounting
+ * rotation and a lever arm (INTEGRATED), the log alone again, so the
+ * integrated filter, the gate, the latency compensation, the damping and
+ * the DVL's measurement run on every target too. */
 #ifndef PYINS_DEMO_SCENARIO_H
 #define PYINS_DEMO_SCENARIO_H
 

@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 15
+#define PYINS_ABI_VERSION_MINOR 16
 
 #ifdef __cplusplus
 extern "C" {
@@ -60,7 +60,8 @@ enum pyins_status {
     PYINS_E_CONFIG_LON = -12,       /* longitude not finite or beyond +-360 deg */
     PYINS_E_CONFIG_HEIGHT = -13,    /* height not finite or outside -1e4..1e5 m */
     PYINS_E_CONFIG_VEL = -14,       /* velocity not finite or faster than 1e4 m/s */
-    PYINS_E_CONFIG_ATT = -15,       /* attitude or table angle not finite */
+    PYINS_E_CONFIG_ATT = -15,       /* attitude, table angle or DVL alignment not finite (the DVL's
+                                       rotation beyond pi) */
     PYINS_E_CONFIG_MODE = -16,      /* unknown vertical-channel mode */
     PYINS_E_CONFIG_ALIGN_RATIO = -17, /* coarse_ratio not in (0, 1) */
     PYINS_E_CONFIG_ALIGN_EARLY = -18, /* first coarse output before enough data: ratio * first < every */
@@ -80,11 +81,13 @@ enum pyins_status {
     PYINS_E_CONFIG_SATURATION = -32,  /* a saturation limit negative or not finite */
     PYINS_E_CONFIG_SEQ = -33,         /* unknown seq_mode, or seq_max_gap_ticks outside 0..100 */
     PYINS_E_CONFIG_INDEX_SUMS = -34,  /* unknown index_sums */
-    PYINS_E_CONFIG_LEVER = -35,       /* a lever-arm component not finite, or a lever arm longer than 100 m */
+    PYINS_E_CONFIG_LEVER = -35,       /* a lever-arm component not finite, or a lever arm longer than 100 m
+                                         (lever_b_m, lever_p_m, dvl_lever_b_m) */
     PYINS_E_CONFIG_COARSE_METHOD = -36, /* unknown coarse_method */
     PYINS_E_CONFIG_INTEGRITY = -37,   /* integrity_nis_window below -1, or a bound negative or not finite */
     PYINS_E_CONFIG_NAV = -38,         /* unknown nav_mode, or a navigation filter setting out of range */
-    PYINS_E_REF_KIND = -39,           /* a reference of an unknown kind (or one this build does not use yet) */
+    PYINS_E_REF_KIND = -39,           /* a reference of an unknown kind (or one this build does not use yet:
+                                         a DVL's water track, reserved != 0) */
     PYINS_E_REF_VALUE = -40,          /* a reference value not finite, or a sigma it uses not finite and > 0 */
     PYINS_E_REF_ORDER = -41,          /* a reference older than the last one pushed, or older than
                                          ref_max_latency_ticks before the current tick */
@@ -204,14 +207,19 @@ enum pyins_nav_mode {
 
 /* Kinds of external reference (pyins_ref.kind; the slot kind - 1 of the
  * per-kind record arrays). Values on the IMU's clock, at the reference
- * point (no antenna lever arm in ABI 0.15). */
+ * point (no antenna lever arm; the DVL's lever arm is dvl_lever_b_m). */
 enum pyins_ref_kind {
     PYINS_REF_GNSS_POS = 1,       /* value: [lat rad, lon rad, height m]; sigma: [E, N, U] m (U unused:
                                      the vertical channel is held) */
     PYINS_REF_GNSS_VEL = 2,       /* value: ENU velocity m/s; sigma: per axis m/s (U unused) */
     PYINS_REF_SPEED_LOG = 3,      /* EM log: value[0] speed through water along the bow [m/s]; sigma[0]
                                      [m/s] (components 1, 2 not used): damps the horizontal channels */
-    PYINS_REF_DVL = 4,            /* reserved: DVL velocity (refused in ABI 0.15) */
+    PYINS_REF_DVL = 4,            /* Doppler velocity log, bottom track (ABI 0.16): value: the velocity
+                                     over ground in the DVL's frame d [m/s], x, y, z; sigma: per axis
+                                     [m/s], all three used (rotated into n). The mounting is the
+                                     configuration's dvl_align_rad, dvl_lever_b_m. pyins_ref.reserved
+                                     must be 0 (bottom track): water track (through water) is not
+                                     used and a non-zero reserved is refused (PYINS_E_REF_KIND) */
     PYINS_REF_ZERO_VEL = 5        /* the ship at rest: value 0; sigma: per axis m/s (U unused) */
 };
 
@@ -222,7 +230,8 @@ enum pyins_ref_kind {
  * carried forward by the velocity over the latency. */
 typedef struct pyins_ref {
     int32_t kind;                 /* enum pyins_ref_kind */
-    int32_t reserved;             /* ignored; keep 0 */
+    int32_t reserved;             /* keep 0; ignored, but for a DVL: 0 = bottom track, anything else
+                                     (water track) refused with PYINS_E_REF_KIND (ABI 0.16) */
     int64_t tick;                 /* tick at whose end the value holds */
     double value[3];
     double sigma[3];
@@ -342,6 +351,12 @@ typedef struct pyins_config {
                                      (chi-square, 2 degrees of freedom); 0 = 13.8 (99.9 %) */
     int32_t nav_reject_limit;     /* rejections in a row that put a kind out of use; 0 = 10 */
     int32_t ref_max_latency_ticks; /* latest a reference may be pushed after its tick [ticks]; 0 = 1 s */
+    /* The DVL's mounting (ABI 0.16; PYINS_REF_DVL; docs/concepts.md, "At sea"). */
+    double dvl_align_rad[3];      /* rotation vector m of the DVL frame d from the ship's b: C_d^b =
+                                     exp([m x]) (the d axes are b's turned by m); 0 = aligned with
+                                     the ship's axes; finite, |m| <= pi (else PYINS_E_CONFIG_ATT) */
+    double dvl_lever_b_m[3];      /* reference point -> DVL, in b [m]; |r| <= 100 m (else
+                                     PYINS_E_CONFIG_LEVER) */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */

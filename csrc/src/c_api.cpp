@@ -43,8 +43,9 @@ int checked(const pyins_core* core, const Firmware** fw) {
 }
 
 constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
-constexpr uint32_t kSnapFormat = 4u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT;
-                                      // 4: the navigation filter and the reference queue
+constexpr uint32_t kSnapFormat = 5u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT;
+                                      // 4: the navigation filter and the reference queue; 5: the DVL's
+                                      // mounting in the configuration (ABI 0.16)
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
@@ -424,7 +425,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_LON: return "PYINS_E_CONFIG_LON: longitude must be finite and within +-720 deg";
         case PYINS_E_CONFIG_HEIGHT: return "PYINS_E_CONFIG_HEIGHT: height must be finite and within -1e4..1e5 m";
         case PYINS_E_CONFIG_VEL: return "PYINS_E_CONFIG_VEL: velocity must be finite and below 1e4 m/s per axis";
-        case PYINS_E_CONFIG_ATT: return "PYINS_E_CONFIG_ATT: attitude angles and table angle must be finite";
+        case PYINS_E_CONFIG_ATT: return "PYINS_E_CONFIG_ATT: attitude angles, table angle and dvl_align_rad must be finite (dvl_align_rad at most pi long)";
         case PYINS_E_CONFIG_MODE: return "PYINS_E_CONFIG_MODE: vertical_mode must be PYINS_VERTICAL_HOLD or PYINS_VERTICAL_FREE";
         case PYINS_E_CONFIG_ALIGN_RATIO: return "PYINS_E_CONFIG_ALIGN_RATIO: coarse_ratio must be in (0, 1) (0 = default 1/2)";
         case PYINS_E_CONFIG_ALIGN_EARLY: return "PYINS_E_CONFIG_ALIGN_EARLY: first coarse output before enough data (coarse_ratio * first output < output interval)";
@@ -444,11 +445,11 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_SATURATION: return "PYINS_E_CONFIG_SATURATION: saturation limits must be positive and finite (0 = default 400 deg/s, 20 g per tick)";
         case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
         case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
-        case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m and lever_p_m must be finite and at most 100 m long";
+        case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m, lever_p_m and dvl_lever_b_m must be finite and at most 100 m long";
         case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or PYINS_COARSE_EQ8";
         case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
         case PYINS_E_CONFIG_NAV: return "PYINS_E_CONFIG_NAV: nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks 1..10 s (0 = default)";
-        case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, SPEED_LOG, ZERO_VEL are used)";
+        case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, SPEED_LOG, DVL bottom track, ZERO_VEL are used; a DVL with reserved != 0, water track, is not)";
         case PYINS_E_REF_VALUE: return "PYINS_E_REF_VALUE: a reference value is not finite (or a latitude beyond 90 deg), or its sigma is not finite and > 0; refused, state unchanged";
         case PYINS_E_REF_ORDER: return "PYINS_E_REF_ORDER: a reference older than the last one pushed, or older than ref_max_latency_ticks before the current tick; refused, state unchanged";
         case PYINS_E_REF_FUTURE: return "PYINS_E_REF_FUTURE: a reference more than 10 s ahead of the current tick; refused, state unchanged";

@@ -194,7 +194,11 @@ int config_check(const pyins_config& raw) {
         std::fabs(cfg.vel_n_mps[1]) > 1e4 || std::fabs(cfg.vel_n_mps[2]) > 1e4) {
         return PYINS_E_CONFIG_VEL;
     }
-    if (!finite3(cfg.euler_b_rad) || !std::isfinite(cfg.table_angle_rad)) {
+    // the DVL's mounting: any rotation, its vector at most pi long (a longer
+    // one is a shorter one's rotation: degrees written as radians)
+    const double* m = cfg.dvl_align_rad;
+    if (!finite3(cfg.euler_b_rad) || !std::isfinite(cfg.table_angle_rad) || !finite3(m) ||
+        !(m[0] * m[0] + m[1] * m[1] + m[2] * m[2] <= kPi * kPi)) {
         return PYINS_E_CONFIG_ATT;
     }
     if (cfg.vertical_mode != PYINS_VERTICAL_HOLD && cfg.vertical_mode != PYINS_VERTICAL_FREE) {
@@ -257,7 +261,7 @@ int config_check(const pyins_config& raw) {
         !(cfg.sat_accel_mps > 0.0) || !std::isfinite(cfg.sat_accel_mps)) {
         return PYINS_E_CONFIG_SATURATION;
     }
-    const double* levers[2] = {cfg.lever_b_m, cfg.lever_p_m};
+    const double* levers[3] = {cfg.lever_b_m, cfg.lever_p_m, cfg.dvl_lever_b_m};
     for (const double* r : levers) {
         if (!finite3(r) || r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > kMaxLeverM * kMaxLeverM) {
             return PYINS_E_CONFIG_LEVER;

@@ -71,7 +71,9 @@ void Firmware::init(const pyins_config& raw) {
     nav_on_ = 0;
     refq_head_ = 0;
     refq_count_ = 0;
-    reserved_nav_ = 0;
+    // the rates the lever arms need: the IMU's (has_lever_) or the DVL's
+    const double* dl = cfg.dvl_lever_b_m;
+    rates_on_ = has_lever_ != 0 || dl[0] != 0.0 || dl[1] != 0.0 || dl[2] != 0.0 ? 1 : 0;
     ref_last_tick_ = -1;
     for (int32_t i = 0; i < kRefKinds; ++i) {
         n_ref_used_[i] = 0u;
@@ -703,6 +705,8 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
                 sd_.nav.height = sd_.nav.height + dvel(2) * dt_;
             }
         }
+    }
+    if (rates_on_ != 0) {
         update_rates(dtheta_p, dalpha);
     }
     // 3. An alignment restart (a sample rejected or missing) begins here.

@@ -56,7 +56,7 @@ inline constexpr int32_t kStraightS = 10;
 /// The current (and the ship's mean sideslip, the yaw swing's bias) is the
 /// mean of v - v_log b over the first kCurrentReadings log readings used
 /// (the velocity then is the alignment's or the references'), then, while
-/// the velocity is known (GNSS velocity or zero velocity in use), a
+/// the velocity is known (GNSS velocity, a DVL or zero velocity in use), a
 /// first-order low-pass over as many readings; held otherwise. Damping
 /// waits for the mean: one reading would carry the yaw swing of the moment
 /// (a few degrees at 8 m/s is 0.5 m/s across the bow).
@@ -232,6 +232,10 @@ class Firmware {
     /// without a lever arm).
     void ref_point_vel(double* east, double* north) const;
     void apply_log(const pyins_ref& ref, int32_t slot);
+    /// A DVL reading (bottom track) as the reference point's velocity (E, N)
+    /// [m/s] in *v_n, with the variances r[2] of its E and N components
+    /// [m^2/s^2] (firmware_nav.cpp says how and what it leaves out).
+    void dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const;
     /// A reference of kind slot + 1 failed its gate: counted; nav_reject_limit
     /// in a row put the kind out of use and set PYINS_FAULT_REF_REJECTED.
     void reject_ref(int32_t slot);
@@ -290,7 +294,7 @@ class Firmware {
     int32_t nav_on_;              ///< 1: the navigation filter runs (NAVIGATE, not UNDAMPED)
     int32_t refq_head_;           ///< index of the oldest queued reference
     int32_t refq_count_;          ///< references queued
-    int32_t reserved_nav_;        ///< (keeps the layout free of padding)
+    int32_t rates_on_;            ///< 1: the rates are kept every tick (an IMU or a DVL lever arm)
     int64_t ref_last_tick_;       ///< tick of the last reference pushed (-1: none)
     pyins_ref refq_[kRefQueue];   ///< the queue, a ring
     nav_filter::NavFilter nav_;

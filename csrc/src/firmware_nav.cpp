@@ -1,5 +1,6 @@
 // firmware_nav.cpp: the firmware at sea: the navigation filter beside the
-// strapdown in NAVIGATE and the external references (pyins_push_ref), the
+// strapdown in NAVIGATE and the external references (pyins_push_ref: GNSS,
+// the EM log's damping, the DVL's bottom track, zero velocity), the
 // Firmware members firmware.hpp declares under "Navigation at sea".
 // Mirrored by pyins/reference/firmware_nav.py; the filter is nav_filter.hpp.
 #include <cmath>
@@ -99,16 +100,20 @@ int Firmware::push_ref(const pyins_ref& ref) {
     if (cfg_.nav_mode == PYINS_NAV_UNDAMPED) {
         return PYINS_E_REF_UNUSED;
     }
-    if (ref.kind != PYINS_REF_GNSS_POS && ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_ZERO_VEL &&
-        ref.kind != PYINS_REF_SPEED_LOG) {
+    // a DVL's reserved field marks its track: bottom track (0) alone is used
+    const bool dvl = ref.kind == PYINS_REF_DVL;
+    if ((ref.kind != PYINS_REF_GNSS_POS && ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_ZERO_VEL &&
+         ref.kind != PYINS_REF_SPEED_LOG && !dvl) ||
+        (dvl && ref.reserved != 0)) {
         return PYINS_E_REF_KIND;
     }
-    // the vertical is held: sigma[2] is not used, nor checked; the log uses
-    // component 0 alone
+    // the vertical is held: sigma[2] is not used, nor checked, but by the
+    // DVL (its axes are turned into n); the log uses component 0 alone
     const bool log = ref.kind == PYINS_REF_SPEED_LOG;
     if (!std::isfinite(ref.value[0]) || !std::isfinite(ref.value[1]) || !std::isfinite(ref.value[2]) ||
         !(ref.sigma[0] > 0.0) || !std::isfinite(ref.sigma[0]) ||
         (!log && (!(ref.sigma[1] > 0.0) || !std::isfinite(ref.sigma[1]))) ||
+        (dvl && (!(ref.sigma[2] > 0.0) || !std::isfinite(ref.sigma[2]))) ||
         (ref.kind == PYINS_REF_GNSS_POS && !(std::fabs(ref.value[0]) <= 0.5 * kPi))) {
         return PYINS_E_REF_VALUE;
     }
@@ -230,8 +235,9 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     log_speed_ = v_log;
     // the current: the mean of the first kCurrentReadings readings, then a
     // low-pass while the velocity is known (GNSS velocity or zero velocity
-    // in use), else held (firmware.hpp)
-    const uint32_t known = (1u << (PYINS_REF_GNSS_VEL - 1)) | (1u << (PYINS_REF_ZERO_VEL - 1));
+    // or a DVL's bottom track in use), else held (firmware.hpp)
+    const uint32_t known =
+        (1u << (PYINS_REF_GNSS_VEL - 1)) | (1u << (PYINS_REF_DVL - 1)) | (1u << (PYINS_REF_ZERO_VEL - 1));
     double n = static_cast<double>(kCurrentReadings);
     if (current_known_ < kCurrentReadings) {
         current_known_ = current_known_ + 1;
@@ -241,6 +247,63 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     }
     current_n_[0] = current_n_[0] + (ve - v_log * be - current_n_[0]) / n;
     current_n_[1] = current_n_[1] + (vn - v_log * bn - current_n_[1]) / n;
+}
+
+void Firmware::dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const {
+    // The DVL, bottom track: the velocity over ground of the DVL's point, in
+    // its own frame d (Groves 2013, ch. 6, Doppler radar and sonar), turned
+    // into n with the INS's own attitude, v = C_b^n C_d^b v_d (C_b^n = C_p^n
+    // C_b^p from the IMU's attitude and the table angle, as bow_n; C_d^b =
+    // exp([m x]), m = dvl_align_rad), and used as a reference velocity: the
+    // loosely coupled velocity update (Groves 2013, ch. 14 and ch. 16 for a
+    // dead-reckoning sensor aiding an INS: the measurement is the difference
+    // of the two velocities in n; H = unit rows on dv_E, dv_N). Not
+    // modelled: the attitude error's share of the turned velocity, v x phi
+    // (1' of heading at 8 m/s is 2.3 mm/s; with it H would have v's columns
+    // on phi), the DVL's scale factor and the mounting left after
+    // calibration (not states: they pass into the velocity, and the position
+    // drifts by the scale factor times the distance made good along the
+    // track, the misalignment about z times it across), the vertical
+    // component (the vertical channel is held), a reading's latency (the
+    // velocity is not carried forward, as GNSS velocity's is not).
+    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+    const double* m = cfg_.dvl_align_rad;
+    const Quat q_bd = attitude::rotvec_to_quat(Vec3(m[0], m[1], m[2]));
+    const Mat3 c_nd = attitude::quat_to_mat(attitude::quat_mul(q_nb, q_bd));
+    Vec3 v = c_nd * Vec3(ref.value[0], ref.value[1], ref.value[2]);
+    const double* l = cfg_.dvl_lever_b_m;
+    if (l[0] != 0.0 || l[1] != 0.0 || l[2] != 0.0) {
+        // The lever arm l (reference point -> DVL, in b): the DVL moves
+        // C_b^n (w_eb^b x l) = C_b^n (w_ib^b x l) - w_ie^n x C_b^n l faster
+        // than the reference point (the Earth-referenced velocity of a lever
+        // arm, as in Groves 2013 ch. 14's velocity measurement), w_ib^b =
+        // C_p^b (w_ip^p - alpha' z) from the rates at the end of this tick
+        // (update_rates), C_p^b = Rz(alpha).
+        double sa;
+        double ca;
+        encoder_sincos(&sa, &ca);
+        const Vec3 w_p = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
+        const Vec3 w_b(ca * w_p(0) - sa * w_p(1), sa * w_p(0) + ca * w_p(1), w_p(2));
+        const Mat3 c_nb = attitude::quat_to_mat(q_nb);
+        const Vec3 lb(l[0], l[1], l[2]);
+        double sin_lat;
+        double cos_lat;
+        pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
+        const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
+        v = v - (c_nb * attitude::cross(w_b, lb) - attitude::cross(w_ie_n, c_nb * lb));
+    }
+    v_n[0] = v(0);
+    v_n[1] = v(1);
+    // R = C_d^n diag(sigma^2) C_n^d, its E and N variances; the covariance
+    // between them is left out (the filter's R is diagonal): it is 0 when
+    // sigma_x = sigma_y and the DVL is level, and small beside them under a
+    // few degrees of roll and pitch unless sigma_z is much the larger
+    const double s0 = ref.sigma[0] * ref.sigma[0];
+    const double s1 = ref.sigma[1] * ref.sigma[1];
+    const double s2 = ref.sigma[2] * ref.sigma[2];
+    for (int i = 0; i < 2; ++i) {
+        r[i] = c_nd(i, 0) * c_nd(i, 0) * s0 + c_nd(i, 1) * c_nd(i, 1) * s1 + c_nd(i, 2) * c_nd(i, 2) * s2;
+    }
 }
 
 void Firmware::damp_interval() {
@@ -321,7 +384,7 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     }
     // z = computed - reference, on the unit rows of dp or dv
     double z[2];
-    const double r[2] = {ref.sigma[0] * ref.sigma[0], ref.sigma[1] * ref.sigma[1]};
+    double r[2] = {ref.sigma[0] * ref.sigma[0], ref.sigma[1] * ref.sigma[1]};
     int k = nav_filter::kVel;
     if (ref.kind == PYINS_REF_GNSS_POS) {
         // carried to this tick by the velocity over the latency
@@ -332,6 +395,12 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     } else if (ref.kind == PYINS_REF_GNSS_VEL) {
         z[0] = vel(0) - ref.value[0];
         z[1] = vel(1) - ref.value[1];
+    } else if (ref.kind == PYINS_REF_DVL) {
+        // a velocity pair like GNSS velocity's, from the DVL's axes (dvl_n)
+        double v_dvl[2];
+        dvl_n(ref, v_dvl, r);
+        z[0] = vel(0) - v_dvl[0];
+        z[1] = vel(1) - v_dvl[1];
     } else {
         z[0] = vel(0);
         z[1] = vel(1);

@@ -35,7 +35,8 @@
 // dv), symmetrised, as moving_align.
 //
 // Measurements (all unit rows: the vertical is held): a reference position
-// on [dp_E, dp_N], a reference or zero velocity on [dv_E, dv_N], R diagonal.
+// on [dp_E, dp_N], a reference or zero velocity on [dv_E, dv_N] (a DVL's
+// velocity turned into n by the firmware, Firmware::dvl_n), R diagonal.
 // Each pair is gated by its joint normalised innovation squared nu^T S^-1 nu
 // (S = H P H^T + R, chi-square with 2 degrees of freedom while the model
 // holds; Bar-Shalom, Li, Kirubarajan 2001, sec. 5.4) before it is used, and

@@ -10,7 +10,7 @@ import zipfile
 
 import numpy as np
 
-from pyins import aiding, engine, logs, replay, replay_options, report, scenario, truth_track
+from pyins import aiding, contract, engine, logs, replay, replay_options, report, scenario, truth_track
 from pyins.logs import nmea as nmea_files
 from pyins.sim import references as reference_files
 from pyins.reference import abi
@@ -79,8 +79,9 @@ def add_replay(cmd):
                         "(docs/cli.md, \"pyins replay\")")
     p.add_argument("--refs", metavar="FILE",
                    help="external references used in navigation (GNSS position and velocity, EM speed "
-                        "log, zero velocity), ticks on the log's clock (tick T: the end of its T-th sample): the text layout "
-                        "'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, \"Reference files\")")
+                        "log, DVL bottom track, zero velocity), ticks on the log's clock (tick T: the end of "
+                        "its T-th sample): the text layout 'tick,kind,v0,v1,v2,s0,s1,s2' (docs/log-formats.md, "
+                        "\"Reference files\")")
     p.add_argument("--gnss", metavar="FILE",
                    help="GNSS fixes used in navigation: an NMEA 0183 file (GGA position, RMC or VTG velocity, "
                         "GST sigmas; needs --nmea-utc-start) or the --refs layout with gnss_pos/gnss_vel rows "
@@ -88,6 +89,16 @@ def add_replay(cmd):
     p.add_argument("--speed-log", metavar="FILE",
                    help="EM speed log used in navigation: an NMEA 0183 file (VHW or VBW water speed; needs "
                         "--nmea-utc-start) or the --refs layout with speed_log rows")
+    p.add_argument("--dvl", metavar="FILE",
+                   help="DVL bottom-track velocities used in navigation (over ground, in the DVL's own axes, "
+                        "m/s): the --refs layout with dvl rows; the DVL's mounting from the scenario or "
+                        "--dvl-align, --dvl-lever")
+    p.add_argument("--dvl-align", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                   help="the DVL's mounting: the rotation vector from the ship's axes to the DVL's [deg] "
+                        "(C_d^b = exp([m x]); default 0, aligned, or the scenario's)")
+    p.add_argument("--dvl-lever", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                   help="the DVL's position from the reference point in the ship's axes, x starboard, y bow, "
+                        "z up [m] (default 0, or the scenario's)")
     p.add_argument("--nmea-utc-start", metavar="UTC",
                    help="the UTC date and time of the log's start (tick 0), e.g. 2026-12-05T10:00:00.00: "
                         "maps the NMEA files' UTC times onto the log's ticks")
@@ -287,13 +298,14 @@ def _row_line(path, index):
 
 
 #: the kinds each file option takes, and the option for the others
-_FILE_KINDS = {"--gnss": ("gnss_pos", "gnss_vel"), "--speed-log": ("speed_log",)}
+_FILE_KINDS = {"--gnss": ("gnss_pos", "gnss_vel"), "--speed-log": ("speed_log",), "--dvl": ("dvl",)}
 
 
 def _reference_file(args, option, path, hz):
-    """The references of ``--gnss FILE`` or ``--speed-log FILE`` (NMEA 0183
-    or the reference text layout, restricted to the option's kinds):
-    (records, what the file gave, warnings); InputError when refused."""
+    """The references of ``--gnss FILE``, ``--speed-log FILE`` (NMEA 0183
+    or the reference text layout) or ``--dvl FILE`` (the reference text
+    layout), restricted to the option's kinds: (records, what the file
+    gave, warnings); InputError when refused."""
     kinds = _FILE_KINDS[option]
     try:
         if os.path.isdir(path):
@@ -303,6 +315,10 @@ def _reference_file(args, option, path, hz):
         nmea = nmea_files.is_nmea(path)
     except OSError as exc:
         raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
+    if nmea and option == "--dvl":
+        raise InputError(f"{option} {path}: an NMEA 0183 file: a DVL's sentences (VBW's two ground-speed "
+                         "axes) are not read; give its readings in the reference text layout, dvl rows of "
+                         "the three axes (docs/log-formats.md, \"Reference files\")")
     if nmea:
         if args._utc_start is None:
             raise InputError(f"{option} {path}: an NMEA 0183 file, whose times are UTC: give --nmea-utc-start, "
@@ -347,7 +363,7 @@ def _reference_file(args, option, path, hz):
     if len(wrong):
         i = int(wrong[0])
         other = {"speed_log": "--speed-log or --refs", "gnss_pos": "--gnss or --refs",
-                 "gnss_vel": "--gnss or --refs"}.get(names[i], "--refs")
+                 "gnss_vel": "--gnss or --refs", "dvl": "--dvl or --refs"}.get(names[i], "--refs")
         raise InputError(f"{option} {path}:{_row_line(path, i)}: a {names[i]} reference; {option} takes "
                          f"{' and '.join(kinds)} ({len(wrong)} rows are not): give the file to {other}")
     counts = {k: int(np.count_nonzero(names == k)) for k in kinds if np.any(names == k)}
@@ -355,13 +371,18 @@ def _reference_file(args, option, path, hz):
 
 
 def _feed(args, cfg, hz):
-    """The external references of --refs, --gnss, --speed-log and
+    """The external references of --refs, --gnss, --speed-log, --dvl and
     --zero-velocity (a `pyins.aiding.BlockFeed`), or None; refused before
     the log runs when they cannot be used. The files' records are merged
-    by tick (stable: --refs, --gnss, --speed-log at one tick)."""
+    by tick (stable: --refs, --gnss, --speed-log, --dvl at one tick). The
+    DVL's mounting (--dvl-align, --dvl-lever) goes into ``cfg``."""
     given = [o for o, v in (("--refs", args.refs), ("--gnss", args.gnss), ("--speed-log", args.speed_log),
-                            ("--zero-velocity", args.zero_velocity)) if v is not None]
+                            ("--dvl", args.dvl), ("--zero-velocity", args.zero_velocity)) if v is not None]
+    mounting = [o for o, v in (("--dvl-align", args.dvl_align), ("--dvl-lever", args.dvl_lever)) if v is not None]
     if not given:
+        if mounting:
+            raise InputError(f"{mounting[0]}: applies to a DVL's readings (--dvl FILE or --refs FILE with dvl "
+                             "rows), none is given")
         return None
     if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
         raise InputError(f"{'/'.join(given)}: the scenario sets firmware.nav_mode = \"undamped\", "
@@ -385,13 +406,8 @@ def _feed(args, cfg, hz):
                              "ASCII); the layout is in docs/log-formats.md, \"Reference files\"") from None
         if not len(refs):
             raise InputError(f"--refs {args.refs}: holds no reference (only its header)")
-        unused = sorted({reference_files.KIND_NAMES[int(k)] for k in refs["kind"]}
-                        - {"gnss_pos", "gnss_vel", "speed_log", "zero_velocity"})
-        if unused:
-            raise InputError(f"--refs {args.refs}: {', '.join(unused)} references are not used by this "
-                             "firmware yet (it takes gnss_pos, gnss_vel, speed_log and zero_velocity)")
         parts.append(refs)
-    for option, path in (("--gnss", args.gnss), ("--speed-log", args.speed_log)):
+    for option, path in (("--gnss", args.gnss), ("--speed-log", args.speed_log), ("--dvl", args.dvl)):
         if path is not None:
             r, source, said = _reference_file(args, option, path, hz)
             parts.append(r)
@@ -405,12 +421,35 @@ def _feed(args, cfg, hz):
     if parts:
         refs = np.concatenate(parts) if len(parts) > 1 else parts[0]
         refs = refs[np.argsort(refs["tick"], kind="stable")]
+    _dvl_mounting(args, cfg, mounting, refs)
     if args.zero_velocity is not None:
         zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
         if not (np.isfinite(zv) and zv > 0.0):
             raise InputError(f"--zero-velocity {args.zero_velocity!r}: a sigma must be more than 0 m/s")
     zv_from = cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
     return aiding.BlockFeed(refs, zv, zv_from, hz, sources=sources, notes=notes)
+
+
+def _dvl_mounting(args, cfg, mounting, refs):
+    """--dvl-align, --dvl-lever into the firmware's dvl_align_rad,
+    dvl_lever_b_m (over the scenario's), refused when no DVL reading is
+    given or the firmware would refuse them."""
+    if not mounting:
+        return
+    if refs is None or not np.any(refs["kind"] == contract.REF_KINDS["dvl"]):
+        raise InputError(f"{mounting[0]}: applies to a DVL's readings (--dvl FILE or --refs FILE with dvl "
+                         "rows), none is given")
+    if args.dvl_align is not None:
+        m = np.radians(np.asarray(args.dvl_align, dtype=float))
+        if not (np.all(np.isfinite(m)) and np.sqrt(np.sum(m * m)) <= np.pi):
+            raise InputError("--dvl-align {:g} {:g} {:g}: a rotation vector at most 180 deg long".format(
+                *args.dvl_align))
+        cfg["dvl_align_rad"] = m
+    if args.dvl_lever is not None:
+        r = np.asarray(args.dvl_lever, dtype=float)
+        if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= 100.0):
+            raise InputError("--dvl-lever {:g} {:g} {:g}: a lever arm at most 100 m long".format(*args.dvl_lever))
+        cfg["dvl_lever_b_m"] = r
 
 
 def _replay(args, path, fmt):

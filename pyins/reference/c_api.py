@@ -160,7 +160,7 @@ def pyins_index_reset(fw):
 
 def pyins_push_ref(fw, ref):
     """One REF_DTYPE record (mirrors pyins_push_ref)."""
-    return fw.push_ref(int(ref["kind"]), int(ref["tick"]), ref["value"], ref["sigma"])
+    return fw.push_ref(int(ref["kind"]), int(ref["tick"]), ref["value"], ref["sigma"], int(ref["reserved"]))
 
 
 def _records(status, n_done, records, dtype):

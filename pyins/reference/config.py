@@ -123,6 +123,8 @@ def config_default():
         "nav_gate": 0.0,
         "nav_reject_limit": 0,
         "ref_max_latency_ticks": 0,
+        "dvl_align_rad": np.zeros(3),
+        "dvl_lever_b_m": np.zeros(3),
     }
 
 
@@ -253,7 +255,9 @@ def config_check(raw):
     v = cfg["vel_n_mps"]
     if not finite3(v) or abs(v[0]) > 1e4 or abs(v[1]) > 1e4 or abs(v[2]) > 1e4:
         return abi.PYINS_E_CONFIG_VEL
-    if not finite3(cfg["euler_b_rad"]) or not math.isfinite(cfg["table_angle_rad"]):
+    m = cfg["dvl_align_rad"]
+    if (not finite3(cfg["euler_b_rad"]) or not math.isfinite(cfg["table_angle_rad"]) or not finite3(m)
+            or not m[0] * m[0] + m[1] * m[1] + m[2] * m[2] <= np.pi * np.pi):
         return abi.PYINS_E_CONFIG_ATT
     if cfg["vertical_mode"] not in (abi.PYINS_VERTICAL_HOLD, abi.PYINS_VERTICAL_FREE):
         return abi.PYINS_E_CONFIG_MODE
@@ -296,7 +300,7 @@ def config_check(raw):
     sat = (cfg["sat_gyro_rad"], cfg["sat_accel_mps"])
     if any(not (v > 0.0) or not math.isfinite(v) for v in sat):
         return abi.PYINS_E_CONFIG_SATURATION
-    for r in (cfg["lever_b_m"], cfg["lever_p_m"]):
+    for r in (cfg["lever_b_m"], cfg["lever_p_m"], cfg["dvl_lever_b_m"]):
         if not finite3(r) or r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > MAX_LEVER_M * MAX_LEVER_M:
             return abi.PYINS_E_CONFIG_LEVER
     if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_EQ8):

@@ -98,6 +98,9 @@ class Firmware(NavAtSea):
         self.prev_dalpha = 0.0
         self.lever_vel_n = np.zeros(3)
         self.lever_refine = 0
+        # the rates the lever arms need: the IMU's (has_lever) or the DVL's (mirrors init)
+        dl = cfg["dvl_lever_b_m"]
+        self.rates_on = 1 if self.has_lever or dl[0] != 0.0 or dl[1] != 0.0 or dl[2] != 0.0 else 0
         self.integrity_lost = 0
         self.init_nav()
         self.fine_vrw = 0.0
@@ -502,6 +505,7 @@ class Firmware(NavAtSea):
                 nav.lon = wrap_pi(nav.lon + dvel[0] * self.dt / ((rn + nav.height) * cos_lat))
                 if self.sd.vertical == strapdown.VERTICAL_FREE:
                     nav.height = nav.height + dvel[2] * self.dt
+        if self.rates_on:
             self.update_rates(dtheta_p, dalpha)
         # 3. An alignment restart (a sample rejected or missing) begins here.
         if self.gap_pending:

@@ -156,7 +156,8 @@ class NavAtSea:
             return
         self.use_ref(slot)
         self.log_speed = v_log
-        known = (1 << (abi.PYINS_REF_GNSS_VEL - 1)) | (1 << (abi.PYINS_REF_ZERO_VEL - 1))
+        known = ((1 << (abi.PYINS_REF_GNSS_VEL - 1)) | (1 << (abi.PYINS_REF_DVL - 1))
+                 | (1 << (abi.PYINS_REF_ZERO_VEL - 1)))
         n = float(CURRENT_READINGS)
         if self.current_known < CURRENT_READINGS:
             self.current_known += 1
@@ -165,6 +166,31 @@ class NavAtSea:
             return
         self.current_n = [self.current_n[0] + (ve - v_log * be - self.current_n[0]) / n,
                           self.current_n[1] + (vn - v_log * bn - self.current_n[1]) / n]
+
+    def dvl_n(self, value, sigma):
+        """A DVL reading (bottom track) as the reference point's velocity (E, N)
+        and the variances of its E, N components (mirrors dvl_n, which says
+        what it leaves out): v = C_b^n C_d^b v_d less the lever arm's share."""
+        q_nb = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+        m = self.cfg["dvl_align_rad"]
+        c_nd = attitude.quat_to_mat(attitude.quat_mul(q_nb, attitude.rotvec_to_quat(
+            np.array([m[0], m[1], m[2]], dtype=float))))
+        v = c_nd @ np.array([value[0], value[1], value[2]], dtype=float)
+        lv = self.cfg["dvl_lever_b_m"]
+        if lv[0] != 0.0 or lv[1] != 0.0 or lv[2] != 0.0:
+            # C_b^n (w_ib^b x l) - w_ie^n x C_b^n l, w_ib^b = Rz(alpha) (w_ip^p - alpha' z)
+            sa, ca = self.encoder_sincos()
+            w_p = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
+            w_b = np.array([ca * w_p[0] - sa * w_p[1], sa * w_p[0] + ca * w_p[1], w_p[2]])
+            c_nb = attitude.quat_to_mat(q_nb)
+            lb = np.array([lv[0], lv[1], lv[2]], dtype=float)
+            lat = self.sd.nav.lat
+            w_ie_n = np.array([0.0, earth.OMEGA_IE * math.cos(lat), earth.OMEGA_IE * math.sin(lat)])
+            v = v - (c_nb @ attitude.cross(w_b, lb) - attitude.cross(w_ie_n, c_nb @ lb))
+        s0, s1, s2 = sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2]
+        r = tuple(c_nd[i, 0] * c_nd[i, 0] * s0 + c_nd[i, 1] * c_nd[i, 1] * s1 + c_nd[i, 2] * c_nd[i, 2] * s2
+                  for i in range(2))
+        return (float(v[0]), float(v[1])), r
 
     def damp_interval(self):
         """The course's turn rate and, in DAMPED, the level damping (mirrors damp_interval)."""
@@ -201,19 +227,23 @@ class NavAtSea:
         nav.vel_n[0] = nav.vel_n[0] - k1 * t * e_e
         nav.vel_n[1] = nav.vel_n[1] - k1 * t * e_n
 
-    def push_ref(self, kind, tick, value, sigma):
+    def push_ref(self, kind, tick, value, sigma, reserved=0):
         """One reference; PYINS_OK or a PYINS_E_REF_* status (mirrors push_ref)."""
         cfg = self.cfg
         if cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED:
             return abi.PYINS_E_REF_UNUSED
-        if kind not in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_ZERO_VEL,
-                        abi.PYINS_REF_SPEED_LOG):
+        # a DVL's reserved field marks its track: bottom track (0) alone is used
+        dvl = kind == abi.PYINS_REF_DVL
+        if (kind not in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_ZERO_VEL,
+                         abi.PYINS_REF_SPEED_LOG, abi.PYINS_REF_DVL)
+                or (dvl and reserved != 0)):
             return abi.PYINS_E_REF_KIND
         value = [float(v) for v in value]
         sigma = [float(s) for s in sigma]
         log = kind == abi.PYINS_REF_SPEED_LOG
         if (not all(math.isfinite(v) for v in value) or not (sigma[0] > 0.0) or not math.isfinite(sigma[0])
                 or (not log and (not (sigma[1] > 0.0) or not math.isfinite(sigma[1])))
+                or (dvl and (not (sigma[2] > 0.0) or not math.isfinite(sigma[2])))
                 or (kind == abi.PYINS_REF_GNSS_POS and not abs(value[0]) <= 0.5 * math.pi)):
             return abi.PYINS_E_REF_VALUE
         if tick < self.ref_last_tick or tick < self.tick - cfg["ref_max_latency_ticks"]:
@@ -263,6 +293,10 @@ class NavAtSea:
             k = nav_filter.POS
         elif kind == abi.PYINS_REF_GNSS_VEL:
             z = (vel[0] - value[0], vel[1] - value[1])
+        elif kind == abi.PYINS_REF_DVL:
+            # a velocity pair like GNSS velocity's, from the DVL's axes (dvl_n)
+            v_dvl, r = self.dvl_n(value, sigma)
+            z = (vel[0] - v_dvl[0], vel[1] - v_dvl[1])
         else:
             z = (vel[0], vel[1])
         nis = nav_filter.nis_pair(self.nav, k, z, r)

@@ -291,6 +291,26 @@ def _windows(raw, where, duration_s):
     return out
 
 
+def _check_dvl_mounting(sub, v, path):
+    """[references.dvl]'s vectors: lists of three (one value for all three
+    axes is no rotation or arm anyone means), the rotation the firmware is
+    told at most 180 deg (its dvl_align_rad's limit), the arm at most 100 m."""
+    for name in ("misalignment", "misalignment_told", "lever"):
+        if name in sub and not isinstance(sub[name], list):
+            raise ScenarioError(f"must be a list of 3 values [x starboard, y bow, z up], got "
+                                f"{_type_name(sub[name])} {sub[name]!r}", f"{path}.{name}")
+    for name, limit, unit in (("misalignment", math.pi, "deg"), ("misalignment_told", math.pi, "deg"),
+                              ("lever", sim_ship.MAX_METRES, "m")):
+        if v[name] is None:
+            continue
+        length = math.sqrt(sum(x * x for x in v[name]))
+        if length > limit:
+            shown = math.degrees(length) if unit == "deg" else length
+            bound = 180.0 if unit == "deg" else limit
+            raise ScenarioError(f"out of range: {'the rotation is' if unit == 'deg' else 'the lever arm is'} "
+                                f"{shown:g} {unit} long; it must be <= {bound:g} {unit}", f"{path}.{name}")
+
+
 def _resolve_references(table, duration_s, firmware):
     """[references]: {gnss: {...}, zero_velocity: {...}}, each only when
     given (SI, the windows as [start_s, end_s] pairs)."""
@@ -318,6 +338,8 @@ def _resolve_references(table, duration_s, firmware):
                 raise ScenarioError(f"{v['outage_length']:g} s: an outage must be shorter than the "
                                     f"interval outage_every ({v['outage_every']:g} s)",
                                     f"{path}.outage_length")
+        if name == "dvl":
+            _check_dvl_mounting(sub, v, path)
         keys_si = {k: key for k, key in keys.items() if k not in ("outages", "frozen")}
         res = _si({k: v[k] for k in keys_si}, keys_si)
         if name == "gnss":

@@ -17,7 +17,8 @@ Kinds (`KIND_NAMES`) and what ``value`` / ``sigma`` hold:
 - SPEED_LOG: value[0] speed through water along the bow axis b y [m/s],
   sigma[0] [m/s]; only component 0 is used, components 1 and 2 are 0.
 - DVL: velocity in the DVL frame d [m/s] (bottom track: over ground; water
-  track: through water); sigma per axis.
+  track: through water, marked ``reserved`` = 1, which the firmware refuses:
+  it uses bottom track alone); sigma per axis.
 - ZERO_VEL: value 0, sigma per axis [m/s] (a moored / at-rest declaration).
 
 Lever arms (reference point -> sensor, in b): r_n = C_b^n l placed with the
@@ -344,8 +345,11 @@ def rotation_vector_to_mat(m):
 def dvl(motion, duration_s, current=None, misalignment_rad=(0.0, 0.0, 0.0), scale_factor=0.0,
         noise_mps=0.01, rate_hz=1.0, lever_b=(0.0, 0.0, 0.0), seed=0, dt=DT):
     """DVL velocity in its frame d [m/s]: bottom track (``current`` None) or
-    water track (a `Current`). C_d^b = exp([m x]) with m = ``misalignment_rad``;
-    v_d = (1 + scale_factor) (C_d^b)^T C_n^b v + noise_mps w per axis."""
+    water track (a `Current`; its records' ``reserved`` is 1, the C ABI's
+    mark of water track, which the firmware refuses with PYINS_E_REF_KIND
+    and the files do not hold). C_d^b = exp([m x]) with m =
+    ``misalignment_rad``; v_d = (1 + scale_factor) (C_d^b)^T C_n^b v +
+    noise_mps w per axis."""
     ticks = schedule(duration_s, rate_hz, dt)
     _, vel, c, t = antenna(motion, ticks, lever_b, dt)
     noise = _nonneg("noise_mps", noise_mps)
@@ -353,7 +357,10 @@ def dvl(motion, duration_s, current=None, misalignment_rad=(0.0, 0.0, 0.0), scal
     v_d = np.einsum("ij,nkj,nk->ni", c_bd, c, vel - _water(current, t))
     w = np.random.default_rng(seed).standard_normal((len(ticks), 3))
     meas = (1.0 + scale_factor) * v_d + noise * w
-    return _records(KIND_DVL, ticks, meas, noise, v_d)
+    out = _records(KIND_DVL, ticks, meas, noise, v_d)
+    if current is not None:
+        out.refs["reserved"] = 1          # water track
+    return out
 
 
 def zero_velocity(duration_s, rate_hz=1.0, sigma_mps=0.01, t0_s=0.0, dt=DT):
@@ -421,13 +428,17 @@ def save_refs_csv(path, refs):
     6 values: above 64 deg the degree grid is coarser than the radian one).
     So the array comes back bit for bit; a reader doing atof(d) * DEG_TO_RAD
     may be 1 ulp (1e-16 rad) off. ``reserved`` and ``avail_tick`` are not
-    written. Refuses (ValueError naming the record) what `load_refs_csv` would.
+    written: a ``dvl`` row is bottom track, and a water-track DVL record
+    (``reserved`` 1) is refused. Refuses (ValueError naming the record) what
+    `load_refs_csv` would.
     """
     refs = refs.refs if isinstance(refs, References) else np.asarray(refs, REF_DTYPE)
     lines, prev = [CSV_HEADER], None
     for i, r in enumerate(refs):
         kind, tick = int(r["kind"]), int(r["tick"])
         bad = _problem(kind, tick, r["value"], r["sigma"], prev)
+        if not bad and kind == KIND_DVL and r["reserved"] != 0:
+            bad = "a water-track dvl record: the layout's dvl rows are bottom track (over ground)"
         if bad:
             raise ValueError(f"{path}: record {i} (line {i + 2}): {bad}")
         prev = tick

@@ -27,6 +27,13 @@ def _pos(tick, lat=LAT, lon=None, sigma=3.0):
     return contract.make_refs("gnss_pos", [tick], [[lat, lon, 0.0]], [[sigma, sigma, 5.0]])
 
 
+def _water_track():
+    # a DVL reading marked as water track (reserved != 0): not used by this firmware
+    r = contract.make_refs("dvl", [50], [[5.0, 0, 0]], [[0.1, 0.1, 0.1]])
+    r["reserved"] = 1
+    return r
+
+
 def _state(fw):
     # the reference engine's snapshot holds its own state; the C one the instance's bytes
     return fw.snapshot()
@@ -34,7 +41,8 @@ def _state(fw):
 
 @pytest.mark.parametrize("eng", ["native", "reference"])
 @pytest.mark.parametrize("ref, status", [
-    (contract.make_refs("dvl", [50], [[5.0, 0, 0]], [[0.1, 0.1, 0.1]]), "PYINS_E_REF_KIND"),
+    (_water_track(), "PYINS_E_REF_KIND"),
+    (contract.make_refs("dvl", [50], [[5.0, 0, 0]], [[0.1, 0.1, 0.0]]), "PYINS_E_REF_VALUE"),
     (contract.make_refs("speed_log", [50], [[5.0, 0, 0]], [[0.0, 0.1, 0.1]]), "PYINS_E_REF_VALUE"),
     (contract.make_refs(9, [50], [[0.0, 0, 0]], [[0.1, 0.1, 0.1]]), "PYINS_E_REF_KIND"),
     (contract.make_refs("gnss_pos", [50], [[np.nan, 0, 0]], [[3, 3, 5]]), "PYINS_E_REF_VALUE"),

@@ -1,6 +1,7 @@
 """At sea through the front door: scenario files with a ship under way
 (`[motion] kind = "voyage"`), external references (`[references.gnss]`,
-`[references.zero_velocity]`) and the navigation mode
+`[references.speed_log]`, `[references.dvl]`, `[references.zero_velocity]`)
+and the navigation mode
 (`firmware.nav_mode`), run by ``pyins run`` with their metrics and page
 (docs/scenarios.md, "[references]")."""
 import json
@@ -10,7 +11,7 @@ import pytest
 
 from pyins import __main__ as cli
 from pyins import contract, metrics, scenario, sim
-from pyins.reference import abi
+from pyins.reference import abi, earth
 from pyins.sim import references as references_csv
 from pyins.sim import voyage
 from pyins.units import DEG_TO_RAD, DT, ScenarioError
@@ -117,6 +118,13 @@ rate = "2 Hz"
     ('[firmware]\nnav_mode = "damped"\n', "firmware.nav_mode", "one of"),
     ('current = "0.2 m/s"\n', "motion.current", "horizontal"),
     ('[references.speed_log]\nsigma = "0 m/s"\n', "references.speed_log.sigma", "out of range"),
+    ('[references.dvl]\nsigma = "0 m/s"\n', "references.dvl.sigma", "out of range"),
+    ('[references.dvl]\nlever = "5 m"\n', "references.dvl.lever", "list of 3"),
+    ('[references.dvl]\nlever = ["0 m", "80 m", "-61 m"]\n', "references.dvl.lever", "100.603 m long"),
+    ('[references.dvl]\nmisalignment_told = ["0 deg", "150 deg", "150 deg"]\n',
+     "references.dvl.misalignment_told", "212.132 deg long"),
+    ('[references.dvl]\nmisalignment = "1 deg"\n', "references.dvl.misalignment", "list of 3"),
+    ('[references.dvl]\nrate = "3 Hz"\n', "references.dvl.rate", "whole number of ticks"),
 ])
 def test_a_bad_reference_key_is_refused_naming_it(extra, key, words):
     with pytest.raises(ScenarioError) as e:
@@ -139,6 +147,28 @@ def test_speed_log_references_are_the_logs_readings():
     still = _spec(VOYAGE).motion.state(np.array([0.0, 300.0]))
     np.testing.assert_allclose(st.vel_n[:, :2] - still.vel_n[:, :2], cur.velocity(np.array([0.0, 300.0]))[:, :2],
                                atol=1e-9)
+
+
+def test_dvl_references_are_the_dvls_readings_and_its_mounting_goes_to_the_firmware():
+    dvl = ('[references.dvl]\nnoise = "0.02 m/s"\nscale_factor = 0.003\nsigma = "0.03 m/s"\nseed = 4\n'
+           'misalignment = ["0.1 deg", "0 deg", "-0.2 deg"]\nlever = ["1 m", "8 m", "-5 m"]\n')
+    spec = _spec(VOYAGE + 'current = ["0.1 m/s", "-0.2 m/s", "0 m/s"]\n' + dvl)
+    refs = spec.refs
+    assert np.all(refs["kind"] == abi.PYINS_REF_DVL) and len(refs) == 600
+    assert np.all(refs["sigma"] == 0.03) and np.all(refs["reserved"] == 0)     # bottom track
+    m = np.array([0.1, 0.0, -0.2]) * DEG_TO_RAD
+    # bottom track: the velocity over ground, whatever the current (the simulator's DVL without one)
+    want = references_csv.dvl(spec.motion, 600.0, None, misalignment_rad=m, scale_factor=0.003, noise_mps=0.02,
+                              lever_b=(1.0, 8.0, -5.0), seed=4)
+    assert np.array_equal(refs["value"], want.refs["value"]) and np.array_equal(refs["tick"], want.refs["tick"])
+    # the mounting told: the misalignment (a calibrated one) and the lever arm
+    np.testing.assert_array_equal(spec.config["dvl_align_rad"], m)
+    np.testing.assert_array_equal(spec.config["dvl_lever_b_m"], [1.0, 8.0, -5.0])
+    # told otherwise: "0 deg" is a mounting not told (the firmware takes the DVL as aligned)
+    told = _spec(VOYAGE + dvl + 'misalignment_told = ["0 deg", "0 deg", "0 deg"]\n')
+    np.testing.assert_array_equal(told.config["dvl_align_rad"], [0.0, 0.0, 0.0])
+    # a scenario without a DVL configures none (its digest is what it was)
+    assert "dvl_align_rad" not in _spec(VOYAGE).config and "dvl" not in scenario.loads(VOYAGE).resolved()
 
 
 def test_nav_mode_goes_to_the_firmware():
@@ -176,6 +206,27 @@ def test_pyins_run_navigates_a_voyage_with_gnss(tmp_path):
     assert (out / "references.png").exists() and not (out_free / "references.png").exists()
     assert "references.png" in (out / "report.html").read_text()
     assert "outage_drift_rms" not in m
+
+
+def test_pyins_run_navigates_a_voyage_with_a_dvl(tmp_path):
+    base = VOYAGE + '[sensors]\npreset = "seed002"\n[firmware]\nfine_sigma0_att = ["1 arcmin", "1 arcmin", "10 arcmin"]\n'
+    dvl = ('[references.dvl]\nmisalignment = ["0.05 deg", "-0.05 deg", "0.1 deg"]\nlever = ["0.5 m", "10 m", "-6 m"]\n'
+           'seed = 2\n')
+    s, out = _run(tmp_path, base + dvl, "dvl")
+    m = s["variants"][0]["metrics"]
+    # the DVL's dead reckoning (tests/atsea/test_dvl.py): its 0.2 % scale
+    # factor times the 3.09 km from the start, 6.2 m; the INS's own share
+    # (1' of heading over it is 0.9 m) and margin: 3 m. Measured 5.95 m; a
+    # run whose readings were not applied drifts 69 m here, one whose
+    # mounting or lever arm did not reach the firmware has its readings
+    # rejected (the lever's ~1 m/s from the roll)
+    st = _spec(VOYAGE).motion.state(np.array([0.0, 600.0]))
+    rm, rn = earth.principal_radii(np.sin(st.lat[0]))
+    made_good = np.hypot((st.lon[1] - st.lon[0]) * rn * np.cos(st.lat[0]), (st.lat[1] - st.lat[0]) * rm)
+    assert 3_000.0 < made_good < 3_200.0
+    assert m["horizontal_error_max"] <= 0.002 * made_good + 3.0
+    assert m["references_rejected"] <= 3            # the gate's 1 in 1000, and margin
+    assert (out / "references.png").exists()
 
 
 def test_pyins_run_holds_a_ship_at_the_pier_by_zero_velocity(tmp_path):

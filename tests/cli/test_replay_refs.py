@@ -1,6 +1,7 @@
 """``pyins replay`` with external references (docs/cli.md, "pyins replay
 LOG"; docs/log-formats.md, "Reference files"): ``--zero-velocity`` for a
-vehicle or ship at rest, ``--refs FILE`` for GNSS fixes on the log's clock.
+vehicle or ship at rest, ``--refs FILE`` for GNSS fixes on the log's clock,
+``--dvl FILE`` for a DVL's bottom-track velocities.
 
 On the real laser-gyro log (tests/data, a parked vehicle, 300 s: 120 s of
 coarse alignment, 180 s of navigation) measured on the landed code
@@ -132,6 +133,34 @@ def test_references_that_do_not_fit_are_warned_about(tmp_path):
     assert "REF_REJECTED" in w
 
 
+def test_a_dvl_holds_a_parked_vehicle_like_zero_velocity(tmp_path, unaided):
+    # A DVL in bottom track on the parked vehicle reads 0 over ground (0.005
+    # m/s of noise, told 0.01 m/s), mounted turned 30 deg about z 2 m ahead:
+    # the firmware turns it by the mounting into n, and the lever's w x r
+    # (the Earth rate only, ~1e-4 m/s) is taken out
+    rng = np.random.default_rng(3)
+    ticks = np.arange(12_100, 30_001, 100)
+    refs = contract.make_refs("dvl", ticks, rng.normal(0.0, 0.005, (len(ticks), 3)), np.full((len(ticks), 3), 0.01))
+    path = tmp_path / "dvl.csv"
+    R.save_refs_csv(str(path), refs)
+    rc, s, _ = _replay(tmp_path, "--dvl", str(path), "--dvl-align", "0", "0", "30", "--dvl-lever", "0", "2", "0")
+    assert rc == 0
+    k = s["references"]["kinds"]["dvl"]
+    assert k["given"] == 180 and k["used"] + k["rejected"] == 180 and k["rejected"] <= 2
+    # within 1 m of rest (measured 0.13 m; zero velocity's exact zeros
+    # 0.021 m) and 3 cm/s: the readings' own noise, 0.005 m/s per axis,
+    # whose largest horizontal norm in 180 is ~0.016 m/s (measured 0.017);
+    # unaided 3.57 m and 0.052 m/s
+    er = s["errors"]
+    assert er["horizontal_max_m"] < 1.0 and er["speed_max_mps"] < 0.03
+    assert unaided["errors"]["horizontal_max_m"] > 3.0 and unaided["errors"]["speed_max_mps"] > 0.03
+    assert s["references"]["sources"][0] == {"option": "--dvl", "file": str(path), "format": "reference text",
+                                             "references": {"dvl": 180}}
+    # and the same rows through --refs are taken too
+    rc, s2, _ = _replay(tmp_path, "--refs", str(path), "--dvl-align", "0", "0", "30", name="refs")
+    assert rc == 0 and s2["references"]["kinds"]["dvl"]["used"] == k["used"]
+
+
 def test_references_only_in_the_alignment_are_said_unused(tmp_path):
     path = tmp_path / "early.csv"
     R.save_refs_csv(str(path), _fixes(np.arange(100, 10_001, 100), 3.0))
@@ -147,8 +176,18 @@ def test_references_only_in_the_alignment_are_said_unused(tmp_path):
     ("tick,kind,v0\n1,gnss_pos,1\n", ["--refs", "{tmp}/r.csv"], "{tmp}/r.csv:1: the header must be"),
     ("tick,kind,v0,v1,v2,s0,s1,s2\n100,gnss_vel,0,0,0,0,0.05,0.05\n", ["--refs", "{tmp}/r.csv"],
      "{tmp}/r.csv:2: sigma [0.0, 0.05, 0.05] must be > 0"),
-    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,dvl,5,0,0,0.05,0.05,0.05\n", ["--refs", "{tmp}/r.csv"],
-     "dvl references are not used by this firmware yet"),
+    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,dvl,5,0,0,0.05,0.05,0\n", ["--refs", "{tmp}/r.csv"],
+     "{tmp}/r.csv:2: sigma [0.05, 0.05, 0.0] must be > 0"),
+    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,gnss_vel,0,0,0,0.05,0.05,0.05\n", ["--dvl", "{tmp}/r.csv"],
+     "{tmp}/r.csv:2: a gnss_vel reference; --dvl takes dvl (1 rows are not): give the file to --gnss or --refs"),
+    ("$GPVBW,5.0,0.1,A,5.1,0.1,A*5C\n", ["--dvl", "{tmp}/r.csv"], "a DVL's sentences"),
+    (None, ["--dvl-align", "0", "0", "1"], "--dvl-align: applies to a DVL's readings"),
+    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,dvl,0,0,0,0.01,0.01,0.01\n",
+     ["--dvl", "{tmp}/r.csv", "--dvl-align", "0", "190", "0"], "--dvl-align 0 190 0: a rotation vector at most 180 deg"),
+    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,dvl,0,0,0,0.01,0.01,0.01\n",
+     ["--refs", "{tmp}/r.csv", "--dvl-lever", "0", "101", "0"], "--dvl-lever 0 101 0: a lever arm at most 100 m"),
+    ("tick,kind,v0,v1,v2,s0,s1,s2\n100,gnss_vel,0,0,0,0.05,0.05,0.05\n",
+     ["--refs", "{tmp}/r.csv", "--dvl-lever", "0", "10", "0"], "--dvl-lever: applies to a DVL's readings"),
     (b"\xff\xfe\x00garbage", ["--refs", "{tmp}/r.csv"], "not a text file of references"),
     (None, ["--zero-velocity", "0 m/s"], "--zero-velocity '0 m/s': a sigma must be more than 0 m/s"),
     (None, ["--zero-velocity", "fast"], "--zero-velocity"),

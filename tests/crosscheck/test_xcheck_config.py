@@ -55,6 +55,10 @@ FIELDS = {
     "integrity_nis_window": values(0, -1, -2, 50),
     "integrity_nis_max": values(0.0, 4.0, -1.0, INF),
     "integrity_coarse_rad": values(0.0, 0.01, -0.01, NAN),
+    # the DVL's mounting (ABI 0.16): a rotation of at most pi, an arm of at most 100 m
+    "dvl_align_rad": values([0.0, 0.0, 0.0], [0.0, 0.0, np.pi], [0.0, 0.0, np.nextafter(np.pi, 4.0)],
+                            [1.0, 2.0, 2.0], [0.0, NAN, 0.0]),
+    "dvl_lever_b_m": values([0.0, 0.0, 0.0], [0.0, 60.0, -80.0], [0.0, 60.0, -80.1], [0.0, 0.0, -INF]),
 }
 
 

@@ -240,6 +240,8 @@ def test_dvl(manoeuvre):
     water = R.dvl(manoeuvre, 1800.0, current=cur, noise_mps=0.0)
     v_w = np.einsum("nji,nj->ni", c, tr.vel_n - [0.5, 0.2, 0.0])
     assert np.abs(water.refs["value"] - v_w).max() < 1e-12
+    # water track is marked (the ABI's reserved = 1: the firmware refuses it), bottom track is not
+    assert np.all(water.refs["reserved"] == 1) and np.all(bottom.refs["reserved"] == 0)
 
 
 def test_zero_velocity():
@@ -266,7 +268,7 @@ def all_kinds(seed=0):
     ship = sim.moored("general", -70.0 * D, 179.9 * D, 5.0, 1.0)
     return R.merge(R.gnss(ship, 60.0, seed=seed, lever_b=(1.0, 2.0, 20.0)),
                    R.speed_log(ship, 60.0, cur, seed=seed),
-                   R.dvl(ship, 60.0, cur, misalignment_rad=(0.01, 0.0, 0.02), seed=seed),
+                   R.dvl(ship, 60.0, None, misalignment_rad=(0.01, 0.0, 0.02), seed=seed),
                    R.zero_velocity(60.0))
 
 
@@ -329,6 +331,10 @@ def test_good_file_and_refused_save(tmp_path):
     refs["sigma"][1, 2] = 0.0
     with pytest.raises(ValueError, match="line 3"):
         R.save_refs_csv(tmp_path / "out.csv", refs)
+    # a water-track DVL has no row: a dvl row is bottom track (the firmware's only track)
+    water = R.dvl(sim.moored("general", 0.0, 0.0, 0.0, 0.0), 5.0, R.Current((0.3, 0.1)))
+    with pytest.raises(ValueError, match="record 0 .*water-track dvl record"):
+        R.save_refs_csv(tmp_path / "out.csv", water)
 
 
 # --- seeds ------------------------------------------------------------------------
