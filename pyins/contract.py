@@ -149,7 +149,7 @@ _STATUS_MEANING = {
     "PYINS_E_CONFIG_SEQ": "seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 "
                           "(0 = default)",
     "PYINS_E_CONFIG_INDEX_SUMS": "index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL",
-    "PYINS_E_CONFIG_LEVER": "lever_b_m, lever_p_m and dvl_lever_b_m must be finite and at most 100 m long",
+    "PYINS_E_CONFIG_LEVER": "lever_b_m, lever_p_m, dvl_lever_b_m and gnss_lever_b_m must be finite and at most 100 m long",
     "PYINS_E_CONFIG_COARSE_METHOD": "coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or "
                                     "PYINS_COARSE_EQ8",
     "PYINS_E_CONFIG_INTEGRITY": "integrity_nis_window must be -1 (off), 0 (default) or positive, "

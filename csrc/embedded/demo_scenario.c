@@ -41,6 +41,12 @@ void demo_config(pyins_config *cfg) {
     cfg->dvl_lever_b_m[0] = 0.25;
     cfg->dvl_lever_b_m[1] = 2.0;
     cfg->dvl_lever_b_m[2] = -3.0;
+    /* the GNSS antenna up the mast (its fixes are the reference point's with
+       noise: the lever arm's path runs, its ~2 m offset is inside the 3 m
+       sigma) */
+    cfg->gnss_lever_b_m[0] = 0.5;
+    cfg->gnss_lever_b_m[1] = 2.0;
+    cfg->gnss_lever_b_m[2] = 12.5;
 }
 
 int demo_fault(uint32_t k) {

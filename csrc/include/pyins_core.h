@@ -207,7 +207,7 @@ enum pyins_nav_mode {
 
 /* Kinds of external reference (pyins_ref.kind; the slot kind - 1 of the
  * per-kind record arrays). Values on the IMU's clock, at the reference
- * point (no antenna lever arm; the DVL's lever arm is dvl_lever_b_m). */
+ * point, or of the antenna at gnss_lever_b_m and the DVL at dvl_lever_b_m. */
 enum pyins_ref_kind {
     PYINS_REF_GNSS_POS = 1,       /* value: [lat rad, lon rad, height m]; sigma: [E, N, U] m (U unused:
                                      the vertical channel is held) */
@@ -356,6 +356,12 @@ typedef struct pyins_config {
                                      exp([m x]) (the d axes are b's turned by m); 0 = aligned with
                                      the ship's axes; finite, |m| <= pi (else PYINS_E_CONFIG_ATT) */
     double dvl_lever_b_m[3];      /* reference point -> DVL, in b [m]; |r| <= 100 m (else
+                                     PYINS_E_CONFIG_LEVER) */
+    /* The GNSS antenna (ABI 0.16; PYINS_REF_GNSS_POS, PYINS_REF_GNSS_VEL). */
+    double gnss_lever_b_m[3];     /* reference point -> the antenna's phase centre, in b [m]: the
+                                     fixes are the antenna's, the firmware compares them with the
+                                     antenna's position and velocity by its own attitude and rates;
+                                     0 = fixes of the reference point; |r| <= 100 m (else
                                      PYINS_E_CONFIG_LEVER) */
 } pyins_config;
 

@@ -445,7 +445,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_SATURATION: return "PYINS_E_CONFIG_SATURATION: saturation limits must be positive and finite (0 = default 400 deg/s, 20 g per tick)";
         case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
         case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
-        case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m, lever_p_m and dvl_lever_b_m must be finite and at most 100 m long";
+        case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m, lever_p_m, dvl_lever_b_m and gnss_lever_b_m must be finite and at most 100 m long";
         case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or PYINS_COARSE_EQ8";
         case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
         case PYINS_E_CONFIG_NAV: return "PYINS_E_CONFIG_NAV: nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks 1..10 s (0 = default)";

@@ -261,7 +261,7 @@ int config_check(const pyins_config& raw) {
         !(cfg.sat_accel_mps > 0.0) || !std::isfinite(cfg.sat_accel_mps)) {
         return PYINS_E_CONFIG_SATURATION;
     }
-    const double* levers[3] = {cfg.lever_b_m, cfg.lever_p_m, cfg.dvl_lever_b_m};
+    const double* levers[4] = {cfg.lever_b_m, cfg.lever_p_m, cfg.dvl_lever_b_m, cfg.gnss_lever_b_m};
     for (const double* r : levers) {
         if (!finite3(r) || r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > kMaxLeverM * kMaxLeverM) {
             return PYINS_E_CONFIG_LEVER;

@@ -71,9 +71,13 @@ void Firmware::init(const pyins_config& raw) {
     nav_on_ = 0;
     refq_head_ = 0;
     refq_count_ = 0;
-    // the rates the lever arms need: the IMU's (has_lever_) or the DVL's
+    // the rates the lever arms need: the IMU's (has_lever_), the DVL's or the antenna's
     const double* dl = cfg.dvl_lever_b_m;
-    rates_on_ = has_lever_ != 0 || dl[0] != 0.0 || dl[1] != 0.0 || dl[2] != 0.0 ? 1 : 0;
+    const double* gl = cfg.gnss_lever_b_m;
+    rates_on_ = has_lever_ != 0 || dl[0] != 0.0 || dl[1] != 0.0 || dl[2] != 0.0 || gl[0] != 0.0 || gl[1] != 0.0 ||
+                        gl[2] != 0.0
+                    ? 1
+                    : 0;
     ref_last_tick_ = -1;
     for (int32_t i = 0; i < kRefKinds; ++i) {
         n_ref_used_[i] = 0u;

@@ -236,6 +236,9 @@ class Firmware {
     /// [m/s] in *v_n, with the variances r[2] of its E and N components
     /// [m^2/s^2] (firmware_nav.cpp says how and what it leaves out).
     void dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const;
+    /// How much faster than the reference point a point at the lever arm l
+    /// (in b) moves, in n: C_b^n (w_eb^b x l) (rates_on_ keeps the rates).
+    Vec3 point_vel_n(const Quat& q_nb, const double* l) const;
     /// A reference of kind slot + 1 failed its gate: counted; nav_reject_limit
     /// in a row put the kind out of use and set PYINS_FAULT_REF_REJECTED.
     void reject_ref(int32_t slot);

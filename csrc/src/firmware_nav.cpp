@@ -249,6 +249,27 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     current_n_[1] = current_n_[1] + (vn - v_log * bn - current_n_[1]) / n;
 }
 
+Vec3 Firmware::point_vel_n(const Quat& q_nb, const double* l) const {
+    // A point at the lever arm l (reference point -> the point, in b) moves
+    // C_b^n (w_eb^b x l) = C_b^n (w_ib^b x l) - w_ie^n x C_b^n l faster than
+    // the reference point (the Earth-referenced velocity of a lever arm,
+    // Groves 2013 ch. 14's velocity measurement), w_ib^b = C_p^b (w_ip^p -
+    // alpha' z) from the rates at the end of this tick (update_rates), C_p^b
+    // = Rz(alpha).
+    double sa;
+    double ca;
+    encoder_sincos(&sa, &ca);
+    const Vec3 w_p = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
+    const Vec3 w_b(ca * w_p(0) - sa * w_p(1), sa * w_p(0) + ca * w_p(1), w_p(2));
+    const Mat3 c_nb = attitude::quat_to_mat(q_nb);
+    const Vec3 lb(l[0], l[1], l[2]);
+    double sin_lat;
+    double cos_lat;
+    pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
+    const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
+    return c_nb * attitude::cross(w_b, lb) - attitude::cross(w_ie_n, c_nb * lb);
+}
+
 void Firmware::dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const {
     // The DVL, bottom track: the velocity over ground of the DVL's point, in
     // its own frame d (Groves 2013, ch. 6, Doppler radar and sonar), turned
@@ -273,24 +294,8 @@ void Firmware::dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const {
     Vec3 v = c_nd * Vec3(ref.value[0], ref.value[1], ref.value[2]);
     const double* l = cfg_.dvl_lever_b_m;
     if (l[0] != 0.0 || l[1] != 0.0 || l[2] != 0.0) {
-        // The lever arm l (reference point -> DVL, in b): the DVL moves
-        // C_b^n (w_eb^b x l) = C_b^n (w_ib^b x l) - w_ie^n x C_b^n l faster
-        // than the reference point (the Earth-referenced velocity of a lever
-        // arm, as in Groves 2013 ch. 14's velocity measurement), w_ib^b =
-        // C_p^b (w_ip^p - alpha' z) from the rates at the end of this tick
-        // (update_rates), C_p^b = Rz(alpha).
-        double sa;
-        double ca;
-        encoder_sincos(&sa, &ca);
-        const Vec3 w_p = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
-        const Vec3 w_b(ca * w_p(0) - sa * w_p(1), sa * w_p(0) + ca * w_p(1), w_p(2));
-        const Mat3 c_nb = attitude::quat_to_mat(q_nb);
-        const Vec3 lb(l[0], l[1], l[2]);
-        double sin_lat;
-        double cos_lat;
-        pmath::sincos(sd_.nav.lat, &sin_lat, &cos_lat);
-        const Vec3 w_ie_n(0.0, earth::kOmegaIe * cos_lat, earth::kOmegaIe * sin_lat);
-        v = v - (c_nb * attitude::cross(w_b, lb) - attitude::cross(w_ie_n, c_nb * lb));
+        // the DVL moves point_vel_n faster than the reference point
+        v = v - point_vel_n(q_nb, l);
     }
     v_n[0] = v(0);
     v_n[1] = v(1);
@@ -382,6 +387,20 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     if (has_lever_ != 0) {
         reference_point(&lat, &lon, &height, &vel);
     }
+    // The GNSS antenna at gnss_lever_b_m: its fixes are compared with the
+    // antenna's position, the reference point's plus C_b^n l, and velocity,
+    // plus point_vel_n (Groves 2013 ch. 14, the lever arm of a loosely
+    // coupled GNSS/INS; the attitude error's share, (C_b^n l) x phi, is not
+    // a row of H: 1' on a 25 m mast is 7 mm)
+    const double* la = cfg_.gnss_lever_b_m;
+    const bool antenna = (ref.kind == PYINS_REF_GNSS_POS || ref.kind == PYINS_REF_GNSS_VEL) &&
+                         (la[0] != 0.0 || la[1] != 0.0 || la[2] != 0.0);
+    Vec3 ant_n = Vec3::Zero();
+    if (antenna) {
+        const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+        ant_n = attitude::quat_to_mat(q_nb) * Vec3(la[0], la[1], la[2]);
+        vel = vel + point_vel_n(q_nb, la);
+    }
     // z = computed - reference, on the unit rows of dp or dv
     double z[2];
     double r[2] = {ref.sigma[0] * ref.sigma[0], ref.sigma[1] * ref.sigma[1]};
@@ -391,6 +410,10 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         const double lag_s = static_cast<double>(lag) * dt_;
         z[0] = wrap_pi(lon - ref.value[1]) * m.rn_h * m.cos_lat - vel(0) * lag_s;
         z[1] = (lat - ref.value[0]) * m.rm_h - vel(1) * lag_s;
+        if (antenna) {
+            z[0] = z[0] + ant_n(0);
+            z[1] = z[1] + ant_n(1);
+        }
         k = nav_filter::kPos;
     } else if (ref.kind == PYINS_REF_GNSS_VEL) {
         z[0] = vel(0) - ref.value[0];

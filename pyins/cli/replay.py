@@ -99,6 +99,9 @@ def add_replay(cmd):
     p.add_argument("--dvl-lever", type=float, nargs=3, metavar=("X", "Y", "Z"),
                    help="the DVL's position from the reference point in the ship's axes, x starboard, y bow, "
                         "z up [m] (default 0, or the scenario's)")
+    p.add_argument("--gnss-lever", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                   help="the GNSS antenna's position from the reference point in the ship's axes, x "
+                        "starboard, y bow, z up [m]: the fixes are the antenna's (default 0, or the scenario's)")
     p.add_argument("--nmea-utc-start", metavar="UTC",
                    help="the UTC date and time of the log's start (tick 0), e.g. 2026-12-05T10:00:00.00: "
                         "maps the NMEA files' UTC times onto the log's ticks")
@@ -383,6 +386,9 @@ def _feed(args, cfg, hz):
         if mounting:
             raise InputError(f"{mounting[0]}: applies to a DVL's readings (--dvl FILE or --refs FILE with dvl "
                              "rows), none is given")
+        if args.gnss_lever is not None:
+            raise InputError("--gnss-lever: applies to GNSS fixes (--gnss FILE or --refs FILE with gnss_pos or "
+                             "gnss_vel rows), none is given")
         return None
     if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
         raise InputError(f"{'/'.join(given)}: the scenario sets firmware.nav_mode = \"undamped\", "
@@ -422,12 +428,28 @@ def _feed(args, cfg, hz):
         refs = np.concatenate(parts) if len(parts) > 1 else parts[0]
         refs = refs[np.argsort(refs["tick"], kind="stable")]
     _dvl_mounting(args, cfg, mounting, refs)
+    _gnss_lever(args, cfg, refs)
     if args.zero_velocity is not None:
         zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
         if not (np.isfinite(zv) and zv > 0.0):
             raise InputError(f"--zero-velocity {args.zero_velocity!r}: a sigma must be more than 0 m/s")
     zv_from = cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
     return aiding.BlockFeed(refs, zv, zv_from, hz, sources=sources, notes=notes)
+
+
+def _gnss_lever(args, cfg, refs):
+    """--gnss-lever into the firmware's gnss_lever_b_m (over the scenario's),
+    refused when no GNSS fix is given or the firmware would refuse it."""
+    if args.gnss_lever is None:
+        return
+    gnss = (contract.REF_KINDS["gnss_pos"], contract.REF_KINDS["gnss_vel"])
+    if refs is None or not np.any(np.isin(refs["kind"], gnss)):
+        raise InputError("--gnss-lever: applies to GNSS fixes (--gnss FILE or --refs FILE with gnss_pos or "
+                         "gnss_vel rows), none is given")
+    r = np.asarray(args.gnss_lever, dtype=float)
+    if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= 100.0):
+        raise InputError("--gnss-lever {:g} {:g} {:g}: a lever arm at most 100 m long".format(*args.gnss_lever))
+    cfg["gnss_lever_b_m"] = r
 
 
 def _dvl_mounting(args, cfg, mounting, refs):

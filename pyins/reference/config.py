@@ -125,6 +125,7 @@ def config_default():
         "ref_max_latency_ticks": 0,
         "dvl_align_rad": np.zeros(3),
         "dvl_lever_b_m": np.zeros(3),
+        "gnss_lever_b_m": np.zeros(3),
     }
 
 
@@ -300,7 +301,7 @@ def config_check(raw):
     sat = (cfg["sat_gyro_rad"], cfg["sat_accel_mps"])
     if any(not (v > 0.0) or not math.isfinite(v) for v in sat):
         return abi.PYINS_E_CONFIG_SATURATION
-    for r in (cfg["lever_b_m"], cfg["lever_p_m"], cfg["dvl_lever_b_m"]):
+    for r in (cfg["lever_b_m"], cfg["lever_p_m"], cfg["dvl_lever_b_m"], cfg["gnss_lever_b_m"]):
         if not finite3(r) or r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > MAX_LEVER_M * MAX_LEVER_M:
             return abi.PYINS_E_CONFIG_LEVER
     if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_EQ8):

@@ -98,9 +98,11 @@ class Firmware(NavAtSea):
         self.prev_dalpha = 0.0
         self.lever_vel_n = np.zeros(3)
         self.lever_refine = 0
-        # the rates the lever arms need: the IMU's (has_lever) or the DVL's (mirrors init)
+        # the rates the lever arms need: the IMU's (has_lever), the DVL's or the antenna's (mirrors init)
         dl = cfg["dvl_lever_b_m"]
-        self.rates_on = 1 if self.has_lever or dl[0] != 0.0 or dl[1] != 0.0 or dl[2] != 0.0 else 0
+        gl = cfg["gnss_lever_b_m"]
+        self.rates_on = 1 if (self.has_lever or dl[0] != 0.0 or dl[1] != 0.0 or dl[2] != 0.0 or gl[0] != 0.0
+                              or gl[1] != 0.0 or gl[2] != 0.0) else 0
         self.integrity_lost = 0
         self.init_nav()
         self.fine_vrw = 0.0

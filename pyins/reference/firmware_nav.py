@@ -167,6 +167,19 @@ class NavAtSea:
         self.current_n = [self.current_n[0] + (ve - v_log * be - self.current_n[0]) / n,
                           self.current_n[1] + (vn - v_log * bn - self.current_n[1]) / n]
 
+    def point_vel_n(self, q_nb, lv):
+        """How much faster than the reference point a point at the lever arm lv
+        (in b) moves, in n (mirrors point_vel_n): C_b^n (w_ib^b x l) - w_ie^n x
+        C_b^n l, w_ib^b = Rz(alpha) (w_ip^p - alpha' z)."""
+        sa, ca = self.encoder_sincos()
+        w_p = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
+        w_b = np.array([ca * w_p[0] - sa * w_p[1], sa * w_p[0] + ca * w_p[1], w_p[2]])
+        c_nb = attitude.quat_to_mat(q_nb)
+        lb = np.array([lv[0], lv[1], lv[2]], dtype=float)
+        lat = self.sd.nav.lat
+        w_ie_n = np.array([0.0, earth.OMEGA_IE * math.cos(lat), earth.OMEGA_IE * math.sin(lat)])
+        return c_nb @ attitude.cross(w_b, lb) - attitude.cross(w_ie_n, c_nb @ lb)
+
     def dvl_n(self, value, sigma):
         """A DVL reading (bottom track) as the reference point's velocity (E, N)
         and the variances of its E, N components (mirrors dvl_n, which says
@@ -178,15 +191,7 @@ class NavAtSea:
         v = c_nd @ np.array([value[0], value[1], value[2]], dtype=float)
         lv = self.cfg["dvl_lever_b_m"]
         if lv[0] != 0.0 or lv[1] != 0.0 or lv[2] != 0.0:
-            # C_b^n (w_ib^b x l) - w_ie^n x C_b^n l, w_ib^b = Rz(alpha) (w_ip^p - alpha' z)
-            sa, ca = self.encoder_sincos()
-            w_p = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
-            w_b = np.array([ca * w_p[0] - sa * w_p[1], sa * w_p[0] + ca * w_p[1], w_p[2]])
-            c_nb = attitude.quat_to_mat(q_nb)
-            lb = np.array([lv[0], lv[1], lv[2]], dtype=float)
-            lat = self.sd.nav.lat
-            w_ie_n = np.array([0.0, earth.OMEGA_IE * math.cos(lat), earth.OMEGA_IE * math.sin(lat)])
-            v = v - (c_nb @ attitude.cross(w_b, lb) - attitude.cross(w_ie_n, c_nb @ lb))
+            v = v - self.point_vel_n(q_nb, lv)
         s0, s1, s2 = sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2]
         r = tuple(c_nd[i, 0] * c_nd[i, 0] * s0 + c_nd[i, 1] * c_nd[i, 1] * s1 + c_nd[i, 2] * c_nd[i, 2] * s2
                   for i in range(2))
@@ -284,12 +289,23 @@ class NavAtSea:
         lat, lon, vel = nav.lat, nav.lon, nav.vel_n.copy()
         if self.has_lever:
             lat, lon, _, vel = self.reference_point()
+        # the GNSS antenna at gnss_lever_b_m (mirrors apply_ref)
+        la = self.cfg["gnss_lever_b_m"]
+        antenna = (kind in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL)
+                   and (la[0] != 0.0 or la[1] != 0.0 or la[2] != 0.0))
+        ant_n = np.zeros(3)
+        if antenna:
+            q_nb = attitude.quat_mul_z(nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+            ant_n = attitude.quat_to_mat(q_nb) @ np.array([la[0], la[1], la[2]], dtype=float)
+            vel = vel + self.point_vel_n(q_nb, la)
         r = (sigma[0] * sigma[0], sigma[1] * sigma[1])
         k = nav_filter.VEL
         if kind == abi.PYINS_REF_GNSS_POS:
             lag_s = float(lag) * self.dt
             z = (wrap_pi(lon - value[1]) * m.rn_h * m.cos_lat - vel[0] * lag_s,
                  (lat - value[0]) * m.rm_h - vel[1] * lag_s)
+            if antenna:
+                z = (z[0] + ant_n[0], z[1] + ant_n[1])
             k = nav_filter.POS
         elif kind == abi.PYINS_REF_GNSS_VEL:
             z = (vel[0] - value[0], vel[1] - value[1])

@@ -207,6 +207,13 @@ def _firmware_config(res, motion):
         # the accelerometers were there (initial_config would give it the motion's)
         cfg["lever_b_m"] = [0.0, 0.0, 0.0]
         cfg["lever_p_m"] = [0.0, 0.0, 0.0]
+    gnss = (res.get("references") or {}).get("gnss")
+    if gnss is not None and (gnss["lever_m"] is not None and any(x != 0.0 for x in gnss["lever_m"])
+                             or gnss["lever_told_m"] is not None):
+        # the antenna's lever arm as the firmware is told it (only when there is one: the
+        # configuration of a scenario without one is what it always was)
+        told = gnss["lever_told_m"]
+        cfg["gnss_lever_b_m"] = list(gnss["lever_m"] if told is None else told)
     dvl = (res.get("references") or {}).get("dvl")
     if dvl is not None:
         # the DVL's mounting as the firmware is told it (only with a DVL: the
@@ -340,7 +347,7 @@ def _references(res, motion):
                                      vel_noise_mps=g["vel_noise_mps"], bias_sigma_m=g["bias_sigma_m"],
                                      bias_tau_s=g["bias_tau_s"], latency_s=g["latency_s"], outages=outages,
                                      outlier_rate=g["outlier_rate"], frozen=[tuple(w) for w in g["frozen"]],
-                                     seed=g["seed"], velocity=g["velocity"]))
+                                     seed=g["seed"], velocity=g["velocity"], lever_b=tuple(g["lever_m"])))
     lg = rt.get("speed_log")
     if lg is not None:
         # the water the ship moves in: a voyage's current (another motion: still water)

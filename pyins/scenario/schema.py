@@ -376,6 +376,11 @@ GNSS_KEYS = {
     "frozen": Key("tables", "a frozen receiver {start, end}: the last fix before start repeated"),
     "seed": Key("int", "seed of the receiver's noise (not the IMU's)", default=0, lo=0),
     "velocity": Key("bool", "give velocity fixes beside the positions", default=True),
+    "lever": Key("length", "reference point -> the antenna [x starboard, y bow, z up]: the fixes are the "
+                           "antenna's", "0 m", lo="-100 m", hi="100 m", shape=3),
+    "lever_told": Key("length", "the antenna's lever arm the firmware is told (its gnss_lever_b_m; "
+                                "default: the lever, a surveyed antenna; \"0 m\": not told)", None,
+                      lo="-100 m", hi="100 m", shape=3),
 }
 #: Keys of one window of [references.gnss] outages or frozen.
 WINDOW_KEYS = {

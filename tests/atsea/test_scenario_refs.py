@@ -171,6 +171,18 @@ def test_dvl_references_are_the_dvls_readings_and_its_mounting_goes_to_the_firmw
     assert "dvl_align_rad" not in _spec(VOYAGE).config and "dvl" not in scenario.loads(VOYAGE).resolved()
 
 
+def test_the_gnss_antennas_lever_arm_moves_the_fixes_and_goes_to_the_firmware():
+    gnss = '[references.gnss]\nseed = 2\nlever = ["1 m", "5 m", "25 m"]\n'
+    spec = _spec(VOYAGE + gnss)
+    want = references_csv.gnss(spec.motion, 600.0, seed=2, pos_noise_m=(3.0, 3.0, 3.0), lever_b=(1.0, 5.0, 25.0))
+    assert np.array_equal(spec.refs["value"], want.refs["value"].astype(float))
+    np.testing.assert_array_equal(spec.config["gnss_lever_b_m"], [1.0, 5.0, 25.0])
+    # told otherwise ("0 m": not told), and none without a lever arm (the digest is what it was)
+    told = _spec(VOYAGE + gnss + 'lever_told = ["0 m", "0 m", "0 m"]\n')
+    np.testing.assert_array_equal(told.config["gnss_lever_b_m"], [0.0, 0.0, 0.0])
+    assert "gnss_lever_b_m" not in _spec(VOYAGE + '[references.gnss]\nseed = 2\n').config
+
+
 def test_nav_mode_goes_to_the_firmware():
     assert _spec(VOYAGE + '[firmware]\nnav_mode = "integrated"\n').config["nav_mode"] == abi.PYINS_NAV_INTEGRATED
     assert "nav_mode" not in _spec(VOYAGE).config

@@ -59,6 +59,8 @@ FIELDS = {
     "dvl_align_rad": values([0.0, 0.0, 0.0], [0.0, 0.0, np.pi], [0.0, 0.0, np.nextafter(np.pi, 4.0)],
                             [1.0, 2.0, 2.0], [0.0, NAN, 0.0]),
     "dvl_lever_b_m": values([0.0, 0.0, 0.0], [0.0, 60.0, -80.0], [0.0, 60.0, -80.1], [0.0, 0.0, -INF]),
+    # the GNSS antenna's lever arm: at most 100 m
+    "gnss_lever_b_m": values([0.0, 0.0, 0.0], [1.0, 5.0, 25.0], [0.0, 80.0, 60.1], [NAN, 0.0, 0.0]),
 }
 
 
