@@ -19,6 +19,7 @@ Gauss-Markov bias over 300 s) with its faults. Measured on the landed code
 
 and the two engines (C++, NumPy mirror) make the same decisions over 60 s
 of the voyage with GNSS, their floats within a few ulps."""
+import engines
 import numpy as np
 import pytest
 
@@ -144,23 +145,6 @@ def test_the_engines_agree_on_a_voyage_with_gnss(motion):
     # fixes at 1 s, 2 s, ... 59 s are in the last record (the one of 60 s
     # arrives after it)
     assert a["n_ref_used"][-1, POS] + a["n_ref_rejected"][-1, POS] == 59
-    # every decision alike: which fix was used or rejected, the mode, the
-    # reference in use (integers, exactly)
-    for name in ("tick", "mode", "n_ref_used", "n_ref_rejected", "n_ref_skipped", "nav_mode", "ref_in_use",
-                 "state_flags", "fault_flags"):
-        assert np.array_equal(a[name], b[name]), name
-    # the floats to a few ulps, not bit for bit: the mirror's sin/cos/atan2
-    # are libm's and its sums NumPy's (pyins.reference.c_api); a CI machine
-    # found a 1e-19 difference in one quaternion and 1e-15 in the NIS.
-    # Bounds far below anything physical, far above the ulps measured:
-    # position 1e-12 rad (6 um), velocity 1e-9 m/s, attitude 1e-10 rad
-    # (2e-5"), the filter's sigmas and NIS to 1e-9 relative, its gyro bias
-    # estimate to 1e-15 rad/s (2e-10 deg/h)
-    assert np.abs(a["lat_rad"] - b["lat_rad"]).max() < 1e-12
-    assert np.abs(a["lon_rad"] - b["lon_rad"]).max() < 1e-12
-    assert np.abs(a["vel_n_mps"] - b["vel_n_mps"]).max() < 1e-9
-    assert np.abs(a["quat_np"] - b["quat_np"]).max() < 0.5e-10     # |dq| ~ angle / 2
-    np.testing.assert_allclose(a["nav_sigma_pos_m"], b["nav_sigma_pos_m"], rtol=1e-9, atol=0.0)
-    np.testing.assert_allclose(a["nav_sigma_heading_rad"], b["nav_sigma_heading_rad"], rtol=1e-9, atol=0.0)
-    np.testing.assert_allclose(a["nav_nis"], b["nav_nis"], rtol=1e-9, atol=1e-12)
-    assert np.abs(a["nav_gyro_bias_rad_s"] - b["nav_gyro_bias_rad_s"]).max() < 1e-15
+    # every decision alike (which fix was used or rejected, the mode, the
+    # reference in use), the floats to a few ulps (tests/engines.py)
+    engines.assert_engines_agree(a, b)
