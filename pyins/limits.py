@@ -97,6 +97,15 @@ def explain(status, cfg, names=None):
         return ("the fine filter's noise densities and initial sigmas "
                 f"({n('fine_gyro_arw')}, {n('fine_accel_vrw')}, {n('fine_sigma0_att_rad')}, ...) must "
                 "be positive and finite")
+    if status == abi.PYINS_E_CONFIG_LEVER:
+        for field in ("lever_b_m", "lever_p_m", "dvl_lever_b_m", "gnss_lever_b_m"):
+            arm = [float(x) for x in r[field]]
+            if not all(math.isfinite(x) for x in arm):
+                return f"{n(field)}: a lever arm must be finite"
+            length = math.sqrt(sum(x * x for x in arm))
+            if length > fw_config.MAX_LEVER_M:
+                return (f"{n(field)}: {length:.4g} m long; a lever arm is at most "
+                        f"{fw_config.MAX_LEVER_M:g} m long")
     if status == abi.PYINS_E_CONFIG_COARSE_METHOD:
         return f"{n('coarse_method')}: triad, fit or eq8"
     return f"the firmware refuses the configuration: {contract.status_str(status)}"

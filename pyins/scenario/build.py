@@ -280,6 +280,8 @@ _STATUS_KEYS = {
 
 #: the firmware fields as a scenario file names them (`pyins.limits`)
 _FIELD_KEYS = {"lat_rad": "motion.lat", "lon_rad": "motion.lon", "height_m": "motion.height",
+               "lever_b_m": "motion.lever_b", "lever_p_m": "motion.lever_p",
+               "dvl_lever_b_m": "references.dvl.lever", "gnss_lever_b_m": "references.gnss.lever (or lever_told)",
                "vel_n_mps": "initial_errors.velocity", "euler_b_rad": "motion",
                "coarse_ticks": "firmware.coarse_time", "coarse_ratio": "firmware.coarse_ratio",
                "coarse_first_output_ticks": "firmware.coarse_first_output",
@@ -299,7 +301,12 @@ def _firmware_check(motion, cfg):
         name = contract.status_str(status).split(":")[0]
         said = f"the firmware refuses the configuration: {contract.status_str(status)}"
         why = limits.explain(status, full, _FIELD_KEYS)
-        raise ScenarioError(said if why == said else f"{said} ({why})", _STATUS_KEYS.get(name, "firmware"))
+        key = _STATUS_KEYS.get(name, "firmware")
+        if name == "PYINS_E_CONFIG_LEVER":
+            # the arm at fault, not the first of them (limits.explain names it first)
+            key = next((k for f, k in _FIELD_KEYS.items() if f.endswith("lever_b_m") or f == "lever_p_m"
+                        if why.startswith(k)), key)
+        raise ScenarioError(said if why == said else f"{said} ({why})", key)
 
 
 # ---------------------------------------------------------------------------

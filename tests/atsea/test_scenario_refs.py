@@ -183,6 +183,14 @@ def test_the_gnss_antennas_lever_arm_moves_the_fixes_and_goes_to_the_firmware():
     assert "gnss_lever_b_m" not in _spec(VOYAGE + '[references.gnss]\nseed = 2\n').config
 
 
+def test_a_lever_arm_the_firmware_refuses_is_named_by_its_key():
+    # each component within the schema's +-100 m, the arm 115.9 m long: the firmware's limit
+    with pytest.raises(ScenarioError) as exc:
+        _spec(VOYAGE + '[references.gnss]\nlever = ["80 m", "80 m", "25 m"]\n')
+    assert exc.value.key == "references.gnss.lever (or lever_told)"
+    assert "115.9 m long; a lever arm is at most 100 m long" in str(exc.value)
+
+
 def test_nav_mode_goes_to_the_firmware():
     assert _spec(VOYAGE + '[firmware]\nnav_mode = "integrated"\n').config["nav_mode"] == abi.PYINS_NAV_INTEGRATED
     assert "nav_mode" not in _spec(VOYAGE).config
