@@ -22,6 +22,7 @@ import json
 import pathlib
 
 import numpy as np
+import parked_site
 import pytest
 
 from pyins import __main__ as cli
@@ -29,11 +30,10 @@ from pyins import contract
 from pyins.logs import nmea as N
 from pyins.reference import earth
 from pyins.sim import references as R
-from pyins.units import DEG_TO_RAD
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 LOG = str(ROOT / "tests/data/lasergyro_300s.imu.gz")
-LAT, LON, H = 34.246048, 108.909664, 380.0        # the log's header (tests/data/README.md)
+LAT, LON, H = parked_site.LAT, parked_site.LON, parked_site.H
 SITE = ["--lat", str(LAT), "--lon", str(LON), "--height", str(H), "--coarse", "120"]
 #: the log's start in UTC: midnight falls at 180 s, inside the navigation (120 .. 300 s)
 START = "2026-12-05T23:57:00.00"
@@ -50,20 +50,7 @@ def _replay(tmp_path, *extra, name="out", log=LOG, site=True):
 
 
 def _fixes(ticks, noise_m, seed=0):
-    """Position fixes of the parked site (white noise ``noise_m``) and
-    velocity fixes (white, 0.05 m/s) at the same ticks (test_replay_refs)."""
-    rng = np.random.default_rng(seed)
-    lat, lon = LAT * DEG_TO_RAD, LON * DEG_TO_RAD
-    rm, rn = earth.principal_radii(np.sin(lat))
-    d = rng.normal(0.0, noise_m, (len(ticks), 2))
-    pos = np.column_stack([lat + d[:, 1] / (rm + H), lon + d[:, 0] / ((rn + H) * np.cos(lat)),
-                           np.full(len(ticks), H)])
-    p = contract.make_refs("gnss_pos", ticks, pos, np.tile([noise_m, noise_m, 5.0], (len(ticks), 1)))
-    v = contract.make_refs("gnss_vel", ticks, np.column_stack([rng.normal(0.0, 0.05, (len(ticks), 2)),
-                                                               np.zeros(len(ticks))]),
-                           np.full((len(ticks), 3), 0.05))
-    both = np.concatenate([p, v])
-    return both[np.argsort(both["tick"], kind="stable")]
+    return parked_site.fixes(ticks, noise_m, seed, up_velocity=False)
 
 
 def _track_gap(a, b):

@@ -14,16 +14,15 @@ about and the warning kept."""
 import json
 
 import numpy as np
+import parked_site
 import pytest
 
 from pyins import __main__ as cli
 from pyins import contract
-from pyins.reference import earth
 from pyins.sim import references as R
-from pyins.units import DEG_TO_RAD
 
 LOG = "tests/data/lasergyro_300s.imu.gz"
-LAT, LON, H = 34.246048, 108.909664, 380.0        # the log's header (tests/data/README.md)
+LAT, LON, H = parked_site.LAT, parked_site.LON, parked_site.H
 SITE = ["--lat", str(LAT), "--lon", str(LON), "--height", str(H), "--coarse", "120"]
 
 
@@ -64,21 +63,7 @@ def test_zero_velocity_holds_a_parked_vehicle_on_real_data(tmp_path, unaided):
 
 
 def _fixes(ticks, noise_m, seed=0):
-    """GNSS position fixes of the parked site, white noise ``noise_m`` per
-    axis, and velocity fixes of white noise 0.05 m/s at the same ticks (a
-    receiver's: one repeating an exact 0 would read as frozen, its repeats
-    unused)."""
-    rng = np.random.default_rng(seed)
-    lat, lon = LAT * DEG_TO_RAD, LON * DEG_TO_RAD
-    rm, rn = earth.principal_radii(np.sin(lat))
-    d = rng.normal(0.0, noise_m, (len(ticks), 2))
-    pos = np.column_stack([lat + d[:, 1] / (rm + H), lon + d[:, 0] / ((rn + H) * np.cos(lat)),
-                           np.full(len(ticks), H)])
-    p = contract.make_refs("gnss_pos", ticks, pos, np.tile([noise_m, noise_m, 5.0], (len(ticks), 1)))
-    v = contract.make_refs("gnss_vel", ticks, rng.normal(0.0, 0.05, (len(ticks), 3)),
-                           np.full((len(ticks), 3), 0.05))
-    both = np.concatenate([p, v])
-    return both[np.argsort(both["tick"], kind="stable")]
+    return parked_site.fixes(ticks, noise_m, seed)
 
 
 def test_a_reference_file_aids_the_navigation(tmp_path, unaided):
