@@ -181,19 +181,37 @@ void Firmware::start_navigation() {
 }
 
 
-void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
+Quat Firmware::ship_quat() const {
     // q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]
-    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
-    // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler): its cosine
-    // and sine are C11 / h and -C01 / h, h = |(C01, C11)| (no angle taken)
+    return attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+}
+
+void Firmware::bow_n(double* east, double* north) const {
+    // C_b^n = C_p^n C_b^p; its column 1 (the bow) is (C01, C11, C21)
+    const Quat q_nb = ship_quat();
     const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
     const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
     const double h = pmath::sqrt(c01 * c01 + c11 * c11);
+    *east = 0.0;    // (a vertical bow: no horizontal direction)
+    *north = 0.0;
+    if (h > 0.0) {
+        *east = c01 / h;
+        *north = c11 / h;
+    }
+}
+
+void Firmware::imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const {
+    // yaw of C_b^n = atan2(-C01, C11) (attitude::mat_to_euler): its cosine
+    // and sine are the bow's north and minus its east component (no angle
+    // taken; -(C01 / h) is -C01 / h bit for bit)
+    double be;
+    double bn;
+    bow_n(&be, &bn);
     double cb = 1.0;   // atan2(0, 0) = 0: the yaw of a vertical x axis
     double sb = 0.0;
-    if (h > 0.0) {
-        cb = c11 / h;
-        sb = -c01 / h;
+    if (be != 0.0 || bn != 0.0) {
+        cb = bn;
+        sb = -be;
     }
     // psi_p = psi_b + alpha by the angle sum
     double sa;

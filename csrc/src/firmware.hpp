@@ -188,6 +188,12 @@ class Firmware {
     void hold_at_site();
     /// Enter NAVIGATE: the indexing cycle starts from the measured angle.
     void start_navigation();
+    /// The ship's attitude q_nb = q_np q_pb from the navigation solution and
+    /// the encoder angle (q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]).
+    Quat ship_quat() const;
+    /// The bow's horizontal direction in n (E, N; unit), from C_b^n's column
+    /// 1; (0, 0) for a vertical bow.
+    void bow_n(double* east, double* north) const;
     /// Sine and cosine of the IMU yaw psi_p = psi_b + alpha (docs/design.md
     /// §2) from the current solution, without taking the angle.
     void imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const;
@@ -226,8 +232,6 @@ class Firmware {
     /// Once a filter interval in NAVIGATE: the course's turn rate and, in
     /// DAMPED, the level damping of the horizontal velocity by the log.
     void damp_interval();
-    /// The bow's horizontal direction in n (E, N; unit), from C_b^n's column 1.
-    void bow_n(double* east, double* north) const;
     /// The reference point's velocity (E, N) [m/s] (the navigated point's
     /// without a lever arm).
     void ref_point_vel(double* east, double* north) const;

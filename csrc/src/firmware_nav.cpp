@@ -175,20 +175,6 @@ void Firmware::use_ref(int32_t slot) {
     ref_used_tick_[slot] = tick_;
 }
 
-void Firmware::bow_n(double* east, double* north) const {
-    // C_b^n = C_p^n C_b^p; its column 1 (the bow) is (C01, C11, C21)
-    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
-    const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
-    const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
-    const double h = pmath::sqrt(c01 * c01 + c11 * c11);
-    *east = 0.0;    // (a vertical bow: no horizontal direction)
-    *north = 0.0;
-    if (h > 0.0) {
-        *east = c01 / h;
-        *north = c11 / h;
-    }
-}
-
 void Firmware::ref_point_vel(double* east, double* north) const {
     Vec3 vel = sd_.nav.vel_n;
     if (has_lever_ != 0) {
@@ -287,7 +273,7 @@ void Firmware::dvl_n(const pyins_ref& ref, double v_n[2], double r[2]) const {
     // track, the misalignment about z times it across), the vertical
     // component (the vertical channel is held), a reading's latency (the
     // velocity is not carried forward, as GNSS velocity's is not).
-    const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+    const Quat q_nb = ship_quat();
     const double* m = cfg_.dvl_align_rad;
     const Quat q_bd = attitude::rotvec_to_quat(Vec3(m[0], m[1], m[2]));
     const Mat3 c_nd = attitude::quat_to_mat(attitude::quat_mul(q_nb, q_bd));
@@ -397,7 +383,7 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
                          (la[0] != 0.0 || la[1] != 0.0 || la[2] != 0.0);
     Vec3 ant_n = Vec3::Zero();
     if (antenna) {
-        const Quat q_nb = attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
+        const Quat q_nb = ship_quat();
         ant_n = attitude::quat_to_mat(q_nb) * Vec3(la[0], la[1], la[2]);
         vel = vel + point_vel_n(q_nb, la);
     }

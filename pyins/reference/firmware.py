@@ -149,18 +149,30 @@ class Firmware(NavAtSea):
         if self.cfg["nav_mode"] != abi.PYINS_NAV_UNDAMPED:
             self.start_nav_filter()
 
-    def imu_yaw_sincos(self):
-        """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors
-        Firmware::imu_yaw_sincos)."""
-        # q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]
-        w, x, y, z = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+    def ship_quat(self):
+        """q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)] (mirrors ship_quat)."""
+        return attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+
+    def bow_n(self):
+        """The bow's horizontal direction in n (E, N; unit): C_b^n's column 1;
+        (0, 0) for a vertical bow (mirrors bow_n)."""
+        w, x, y, z = self.ship_quat()
         c01 = 2.0 * (x * y - w * z)
         c11 = w * w - x * x + y * y - z * z
-        h = np.sqrt(c01 * c01 + c11 * c11)
-        cb, sb = 1.0, 0.0  # atan2(0, 0) = 0
+        h = math.sqrt(c01 * c01 + c11 * c11)
         if h > 0.0:
-            cb = c11 / h
-            sb = -c01 / h
+            return c01 / h, c11 / h
+        return 0.0, 0.0
+
+    def imu_yaw_sincos(self):
+        """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors
+        Firmware::imu_yaw_sincos): the yaw's cosine and sine are the bow's
+        north and minus its east component."""
+        be, bn = self.bow_n()
+        cb, sb = 1.0, 0.0  # atan2(0, 0) = 0
+        if be != 0.0 or bn != 0.0:
+            cb = bn
+            sb = -be
         sa, ca = self.encoder_sincos()
         return sb * ca + cb * sa, cb * ca - sb * sa
 

@@ -122,16 +122,6 @@ class NavAtSea:
         self.n_ref_used[slot] = count(self.n_ref_used[slot])
         self.ref_used_tick[slot] = self.tick
 
-    def bow_n(self):
-        """The bow's horizontal direction in n (E, N; unit): C_b^n's column 1."""
-        w, x, y, z = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
-        c01 = 2.0 * (x * y - w * z)
-        c11 = w * w - x * x + y * y - z * z
-        h = math.sqrt(c01 * c01 + c11 * c11)
-        if h > 0.0:
-            return c01 / h, c11 / h
-        return 0.0, 0.0
-
     def ref_point_vel(self):
         vel = self.sd.nav.vel_n
         if self.has_lever:
@@ -184,7 +174,7 @@ class NavAtSea:
         """A DVL reading (bottom track) as the reference point's velocity (E, N)
         and the variances of its E, N components (mirrors dvl_n, which says
         what it leaves out): v = C_b^n C_d^b v_d less the lever arm's share."""
-        q_nb = attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+        q_nb = self.ship_quat()
         m = self.cfg["dvl_align_rad"]
         c_nd = attitude.quat_to_mat(attitude.quat_mul(q_nb, attitude.rotvec_to_quat(
             np.array([m[0], m[1], m[2]], dtype=float))))
@@ -295,7 +285,7 @@ class NavAtSea:
                    and (la[0] != 0.0 or la[1] != 0.0 or la[2] != 0.0))
         ant_n = np.zeros(3)
         if antenna:
-            q_nb = attitude.quat_mul_z(nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
+            q_nb = self.ship_quat()
             ant_n = attitude.quat_to_mat(q_nb) @ np.array([la[0], la[1], la[2]], dtype=float)
             vel = vel + self.point_vel_n(q_nb, la)
         r = (sigma[0] * sigma[0], sigma[1] * sigma[1])
