@@ -14,6 +14,7 @@ from pyins import aiding, contract, engine, logs, replay, replay_options, report
 from pyins.logs import nmea as nmea_files
 from pyins.sim import references as reference_files
 from pyins.reference import abi
+from pyins.reference import config as fw_config
 from pyins.report import replay as report_replay
 
 from .common import EXIT_INTERRUPTED, EXIT_OK, InputError, default_out, emit_json, progress_bars, say
@@ -273,10 +274,10 @@ def cmd_replay(args):
 
 
 def _refs_csv(option, path):
-    """A file of the reference text layout (`load_refs_csv`), or InputError
-    naming ``option``."""
+    """A file of the reference text layout (`load_refs_csv`) holding at
+    least one reference, or InputError naming ``option``."""
     try:
-        return reference_files.load_refs_csv(path)
+        refs = reference_files.load_refs_csv(path)
     except OSError as exc:
         raise InputError(f"{option} {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
@@ -284,6 +285,9 @@ def _refs_csv(option, path):
                          "ASCII); the layout is in docs/log-formats.md, \"Reference files\"") from None
     except ValueError as exc:
         raise InputError(f"{option} {exc}") from None
+    if not len(refs):
+        raise InputError(f"{option} {path}: holds no reference (only its header)")
+    return refs
 
 
 def _row_line(path, index):
@@ -359,17 +363,16 @@ def _reference_file(args, option, path, hz):
                          f"reference text layout (its header {reference_files.CSV_HEADER!r}; docs/log-formats.md, "
                          "\"Reference files\")" + (f": {what}" if what else ""))
     refs = _refs_csv(option, path)
-    if not len(refs):
-        raise InputError(f"{option} {path}: holds no reference (only its header)")
-    names = np.array([reference_files.KIND_NAMES.get(int(k), "?") for k in refs["kind"]])
-    wrong = np.flatnonzero(~np.isin(names, kinds))
+    codes = {k: contract.REF_KINDS[k] for k in kinds}
+    wrong = np.flatnonzero(~np.isin(refs["kind"], list(codes.values())))
     if len(wrong):
         i = int(wrong[0])
+        name = reference_files.KIND_NAMES.get(int(refs["kind"][i]), "?")
         other = {"speed_log": "--speed-log or --refs", "gnss_pos": "--gnss or --refs",
-                 "gnss_vel": "--gnss or --refs", "dvl": "--dvl or --refs"}.get(names[i], "--refs")
-        raise InputError(f"{option} {path}:{_row_line(path, i)}: a {names[i]} reference; {option} takes "
+                 "gnss_vel": "--gnss or --refs", "dvl": "--dvl or --refs"}.get(name, "--refs")
+        raise InputError(f"{option} {path}:{_row_line(path, i)}: a {name} reference; {option} takes "
                          f"{' and '.join(kinds)} ({len(wrong)} rows are not): give the file to {other}")
-    counts = {k: int(np.count_nonzero(names == k)) for k in kinds if np.any(names == k)}
+    counts = {k: n for k, n in ((k, int(np.count_nonzero(refs["kind"] == c))) for k, c in codes.items()) if n}
     return refs, dict(option=option, file=path, format="reference text", references=counts), []
 
 
@@ -383,12 +386,8 @@ def _feed(args, cfg, hz):
                             ("--dvl", args.dvl), ("--zero-velocity", args.zero_velocity)) if v is not None]
     mounting = [o for o, v in (("--dvl-align", args.dvl_align), ("--dvl-lever", args.dvl_lever)) if v is not None]
     if not given:
-        if mounting:
-            raise InputError(f"{mounting[0]}: applies to a DVL's readings (--dvl FILE or --refs FILE with dvl "
-                             "rows), none is given")
-        if args.gnss_lever is not None:
-            raise InputError("--gnss-lever: applies to GNSS fixes (--gnss FILE or --refs FILE with gnss_pos or "
-                             "gnss_vel rows), none is given")
+        _dvl_mounting(args, cfg, mounting, None)     # refused: there is nothing they apply to
+        _gnss_lever(args, cfg, None)
         return None
     if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
         raise InputError(f"{'/'.join(given)}: the scenario sets firmware.nav_mode = \"undamped\", "
@@ -403,15 +402,7 @@ def _feed(args, cfg, hz):
         if nmea:
             raise InputError(f"--refs {args.refs}: an NMEA 0183 file: give it to --gnss (GGA, RMC, VTG) or "
                              "--speed-log (VHW, VBW), with --nmea-utc-start")
-        try:
-            refs = reference_files.load_refs_csv(args.refs)
-        except OSError as exc:
-            raise InputError(f"--refs {args.refs}: {exc.strerror or exc}") from None
-        except UnicodeDecodeError:
-            raise InputError(f"--refs {args.refs}: not a text file of references (bytes that are not "
-                             "ASCII); the layout is in docs/log-formats.md, \"Reference files\"") from None
-        if not len(refs):
-            raise InputError(f"--refs {args.refs}: holds no reference (only its header)")
+        refs = _refs_csv("--refs", args.refs)
         parts.append(refs)
     for option, path in (("--gnss", args.gnss), ("--speed-log", args.speed_log), ("--dvl", args.dvl)):
         if path is not None:
@@ -447,8 +438,9 @@ def _gnss_lever(args, cfg, refs):
         raise InputError("--gnss-lever: applies to GNSS fixes (--gnss FILE or --refs FILE with gnss_pos or "
                          "gnss_vel rows), none is given")
     r = np.asarray(args.gnss_lever, dtype=float)
-    if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= 100.0):
-        raise InputError("--gnss-lever {:g} {:g} {:g}: a lever arm at most 100 m long".format(*args.gnss_lever))
+    if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= fw_config.MAX_LEVER_M):
+        raise InputError("--gnss-lever {:g} {:g} {:g}: a lever arm at most {:g} m long".format(
+            *args.gnss_lever, fw_config.MAX_LEVER_M))
     cfg["gnss_lever_b_m"] = r
 
 
@@ -469,8 +461,9 @@ def _dvl_mounting(args, cfg, mounting, refs):
         cfg["dvl_align_rad"] = m
     if args.dvl_lever is not None:
         r = np.asarray(args.dvl_lever, dtype=float)
-        if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= 100.0):
-            raise InputError("--dvl-lever {:g} {:g} {:g}: a lever arm at most 100 m long".format(*args.dvl_lever))
+        if not (np.all(np.isfinite(r)) and np.sqrt(np.sum(r * r)) <= fw_config.MAX_LEVER_M):
+            raise InputError("--dvl-lever {:g} {:g} {:g}: a lever arm at most {:g} m long".format(
+                *args.dvl_lever, fw_config.MAX_LEVER_M))
         cfg["dvl_lever_b_m"] = r
 
 
