@@ -35,6 +35,20 @@ def _s(ticks, hz):
     return f"{ticks / hz:g} s"
 
 
+def lever_at_fault(cfg):
+    """(field, what is wrong) of the first lever arm of ``cfg`` the core
+    refuses (PYINS_E_CONFIG_LEVER), or None."""
+    r = resolved(cfg)
+    for field in ("lever_b_m", "lever_p_m", "dvl_lever_b_m", "gnss_lever_b_m"):
+        arm = [float(x) for x in r[field]]
+        if not all(math.isfinite(x) for x in arm):
+            return field, "a lever arm must be finite"
+        length = math.sqrt(sum(x * x for x in arm))
+        if length > fw_config.MAX_LEVER_M:
+            return field, f"{length:.4g} m long; a lever arm is at most {fw_config.MAX_LEVER_M:g} m long"
+    return None
+
+
 def explain(status, cfg, names=None):
     """A sentence saying why the core refused ``cfg`` with ``status`` and how
     to get inside the limit; ``names`` maps field names to the user's."""
@@ -98,14 +112,9 @@ def explain(status, cfg, names=None):
                 f"({n('fine_gyro_arw')}, {n('fine_accel_vrw')}, {n('fine_sigma0_att_rad')}, ...) must "
                 "be positive and finite")
     if status == abi.PYINS_E_CONFIG_LEVER:
-        for field in ("lever_b_m", "lever_p_m", "dvl_lever_b_m", "gnss_lever_b_m"):
-            arm = [float(x) for x in r[field]]
-            if not all(math.isfinite(x) for x in arm):
-                return f"{n(field)}: a lever arm must be finite"
-            length = math.sqrt(sum(x * x for x in arm))
-            if length > fw_config.MAX_LEVER_M:
-                return (f"{n(field)}: {length:.4g} m long; a lever arm is at most "
-                        f"{fw_config.MAX_LEVER_M:g} m long")
+        fault = lever_at_fault(cfg)
+        if fault is not None:
+            return f"{n(fault[0])}: {fault[1]}"
     if status == abi.PYINS_E_CONFIG_COARSE_METHOD:
         return f"{n('coarse_method')}: triad, fit or eq8"
     return f"the firmware refuses the configuration: {contract.status_str(status)}"

@@ -13,7 +13,7 @@ import numpy as np
 
 from pyins import contract, limits, sim
 from pyins import engine as engines
-from pyins.reference import attitude, earth
+from pyins.reference import abi, attitude, earth
 from pyins.scenario.schema import (COARSE_METHODS, FINE_CORRECTIONS, FINE_NOISES, INDEX_SUMS, NAV_MODES, VERTICAL_MODES,
                                    _LINEAR_AXES, _STEP_MOVES, _TABLE_FAULTS)
 from pyins.sim import references, turntable, voyage
@@ -302,10 +302,9 @@ def _firmware_check(motion, cfg):
         said = f"the firmware refuses the configuration: {contract.status_str(status)}"
         why = limits.explain(status, full, _FIELD_KEYS)
         key = _STATUS_KEYS.get(name, "firmware")
-        if name == "PYINS_E_CONFIG_LEVER":
-            # the arm at fault, not the first of them (limits.explain names it first)
-            key = next((k for f, k in _FIELD_KEYS.items() if f.endswith("lever_b_m") or f == "lever_p_m"
-                        if why.startswith(k)), key)
+        fault = limits.lever_at_fault(full) if status == abi.PYINS_E_CONFIG_LEVER else None
+        if fault is not None:
+            key = _FIELD_KEYS[fault[0]]       # the arm at fault, not the first of them
         raise ScenarioError(said if why == said else f"{said} ({why})", key)
 
 
