@@ -291,16 +291,22 @@ def _windows(raw, where, duration_s):
     return out
 
 
-def _check_dvl_mounting(sub, v, path):
-    """[references.dvl]'s vectors: lists of three (one value for all three
-    axes is no rotation or arm anyone means), the rotation the firmware is
-    told at most 180 deg (its dvl_align_rad's limit), the arm at most 100 m."""
-    for name in ("misalignment", "misalignment_told", "lever"):
+#: a reference sensor's mounting vectors: (name, the firmware's limit on its length, unit)
+_MOUNTINGS = {"dvl": (("misalignment", math.pi, "deg"), ("misalignment_told", math.pi, "deg"),
+                      ("lever", sim_ship.MAX_METRES, "m")),
+              "gnss": (("lever", sim_ship.MAX_METRES, "m"), ("lever_told", sim_ship.MAX_METRES, "m"))}
+
+
+def _check_mounting(sub, v, path, vectors):
+    """A sensor's mounting vectors ([references.dvl]'s rotations and arm,
+    [references.gnss]'s antenna arm): lists of three (one value for all
+    three axes is no rotation or arm anyone means), a rotation at most 180
+    deg (dvl_align_rad's limit), an arm at most 100 m (the firmware's)."""
+    for name, _, _ in vectors:
         if name in sub and not isinstance(sub[name], list):
             raise ScenarioError(f"must be a list of 3 values [x starboard, y bow, z up], got "
                                 f"{_type_name(sub[name])} {sub[name]!r}", f"{path}.{name}")
-    for name, limit, unit in (("misalignment", math.pi, "deg"), ("misalignment_told", math.pi, "deg"),
-                              ("lever", sim_ship.MAX_METRES, "m")):
+    for name, limit, unit in vectors:
         if v[name] is None:
             continue
         length = math.sqrt(sum(x * x for x in v[name]))
@@ -338,8 +344,8 @@ def _resolve_references(table, duration_s, firmware):
                 raise ScenarioError(f"{v['outage_length']:g} s: an outage must be shorter than the "
                                     f"interval outage_every ({v['outage_every']:g} s)",
                                     f"{path}.outage_length")
-        if name == "dvl":
-            _check_dvl_mounting(sub, v, path)
+        if name in _MOUNTINGS:
+            _check_mounting(sub, v, path, _MOUNTINGS[name])
         keys_si = {k: key for k, key in keys.items() if k not in ("outages", "frozen")}
         res = _si({k: v[k] for k in keys_si}, keys_si)
         if name == "gnss":

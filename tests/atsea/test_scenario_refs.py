@@ -183,12 +183,17 @@ def test_the_gnss_antennas_lever_arm_moves_the_fixes_and_goes_to_the_firmware():
     assert "gnss_lever_b_m" not in _spec(VOYAGE + '[references.gnss]\nseed = 2\n').config
 
 
-def test_a_lever_arm_the_firmware_refuses_is_named_by_its_key():
+def test_an_antenna_lever_arm_that_cannot_be_is_refused_at_its_key():
     # each component within the schema's +-100 m, the arm 115.9 m long: the firmware's limit
     with pytest.raises(ScenarioError) as exc:
         _spec(VOYAGE + '[references.gnss]\nlever = ["80 m", "80 m", "25 m"]\n')
-    assert exc.value.key == "references.gnss.lever (or lever_told)"
-    assert "115.9 m long; a lever arm is at most 100 m long" in str(exc.value)
+    assert exc.value.key == "references.gnss.lever"
+    assert "the lever arm is 115.866 m long; it must be <= 100 m" in str(exc.value)
+    # one value for all three axes is no arm anyone means
+    with pytest.raises(ScenarioError) as exc:
+        _spec(VOYAGE + '[references.gnss]\nlever_told = "5 m"\n')
+    assert exc.value.key == "references.gnss.lever_told"
+    assert "must be a list of 3 values" in str(exc.value)
 
 
 def test_nav_mode_goes_to_the_firmware():
