@@ -60,6 +60,7 @@ other than N/S or E/W as 0 deg: silent wrong values this reader refuses
 field by field (tests/logs/test_nmea.py).
 """
 import datetime
+import lzma
 import math
 import os
 import re
@@ -67,7 +68,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pyins.logs.files import _opener
+from pyins.logs.files import _opener, _read_bytes
+from pyins.logs.issues import LogError
 from pyins.sim.references import (KIND_GNSS_POS, KIND_GNSS_VEL, KIND_NAMES, KIND_SPEED_LOG, REF_DTYPE)
 from pyins.units import DEG_TO_RAD, NMI_TO_M
 
@@ -212,15 +214,12 @@ def looks_like_nmea(text):
 
 
 def _read_text(path, name):
-    """The file's text (decompressed when gzip/xz/bzip2), or NmeaError."""
-    comp, opener = _opener(path)
+    """The file's text (decompressed when gzip/xz/bzip2, as the logs'
+    `_read_bytes`), or NmeaError."""
     try:
-        with opener(path, "rb") as f:
-            raw = f.read()
-    except (OSError, EOFError, ValueError) as exc:
-        if comp is None:
-            raise
-        raise NmeaError(f"{name}: not a complete {comp} stream ({exc})") from None
+        raw = _read_bytes(path, name)
+    except LogError as exc:             # a broken compressed stream
+        raise NmeaError(str(exc)) from None
     if b"\x00" in raw[:1 << 16]:
         raise NmeaError(f"{name}: not a text file (NUL bytes): NMEA 0183 is lines of ASCII text")
     return raw.removeprefix(b"\xef\xbb\xbf").decode("ascii", errors="replace")    # a UTF-8 BOM: not a byte of it
@@ -233,7 +232,7 @@ def is_nmea(path):
     with opener(path, "rb") as f:
         try:
             head = f.read(1 << 16)
-        except (EOFError, ValueError):       # a broken stream: read_nmea names it
+        except (EOFError, ValueError, lzma.LZMAError):       # a broken stream: read_nmea names it
             return comp is not None
     return b"\x00" not in head and looks_like_nmea(head.removeprefix(b"\xef\xbb\xbf").decode("ascii", errors="replace"))
 

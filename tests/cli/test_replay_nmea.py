@@ -19,6 +19,7 @@ late: the first one's correction lands after a record), written with 4
 decimals of a minute (9.3 cm of rounding) 3.7 cm.
 """
 import json
+import lzma
 import pathlib
 
 import numpy as np
@@ -215,6 +216,15 @@ def _nmea_file(tmp):
     return p
 
 
+def _damaged_xz(text):
+    """``text`` xz-compressed, its middle bytes flipped (the header and the
+    stream's end intact: lzma says "Corrupt input data")."""
+    b = bytearray(lzma.compress(text.encode()))
+    for i in range(20, len(b) - 20):
+        b[i] ^= 0x55
+    return bytes(b)
+
+
 CASES = [
     # (files to make, argv, words of the one-line error)
     ({}, ["--gnss", "{tmp}/missing.nmea", "--nmea-utc-start", "2026-12-05T10:00:00"],
@@ -265,6 +275,11 @@ CASES = [
      "--speed-log {tmp}/r.csv:2: sigma [0.0] must be > 0"),
     ("nmea", ["--refs", "{tmp}/rx.nmea"],
      "--refs {tmp}/rx.nmea: an NMEA 0183 file: give it to --gnss (GGA, RMC, VTG) or --speed-log (VHW, VBW)"),
+    # a compressed file damaged inside (lzma's own error, not an EOF): it was an internal error
+    ({"bad.nmea.xz": _damaged_xz(N.sentence("GPGGA,100000.00,3414.7629,N,10854.5798,E,1,08,0.9,380.0,M,0.0,M,,")
+                                 + "\n")},
+     ["--gnss", "{tmp}/bad.nmea.xz", "--nmea-utc-start", "2026-12-05T10:00:00"],
+     "--gnss {tmp}/bad.nmea.xz: not a complete xz stream"),
 ]
 
 
