@@ -154,7 +154,7 @@ _STATUS_MEANING = {
                                     "PYINS_COARSE_EQ8",
     "PYINS_E_CONFIG_INTEGRITY": "integrity_nis_window must be -1 (off), 0 (default) or positive, "
                                 "integrity_nis_max and integrity_coarse_rad finite and not negative",
-    "PYINS_E_CONFIG_NAV": "nav_mode must be AUTO, UNDAMPED or INTEGRATED, nav_every_ticks 1..10 s, "
+    "PYINS_E_CONFIG_NAV": "nav_mode must be AUTO, UNDAMPED, DAMPED or INTEGRATED, nav_every_ticks 1..10 s, "
                           "nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks "
                           "1..10 s (0 = default)",
     "PYINS_E_REF_KIND": "unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, "
@@ -167,7 +167,7 @@ _STATUS_MEANING = {
     "PYINS_E_REF_FUTURE": "a reference more than 10 s ahead of the current tick; refused, state unchanged",
     "PYINS_E_REF_FULL": "the reference queue (8) is full: step the samples its references wait for first; "
                         "refused, state unchanged",
-    "PYINS_E_REF_UNUSED": "nav_mode is UNDAMPED: the firmware takes no references",
+    "PYINS_E_REF_UNUSED": "nav_mode is UNDAMPED (the firmware takes no references) or DAMPED (it takes no GNSS position)",
     "PYINS_W_SEQ_GAP": "ticks missing before this sample: bridged (navigation) or alignment restarted; "
                        "sample taken",
     "PYINS_W_SEQ_REPEAT": "a sample already taken (seq repeated or behind): dropped, state unchanged",

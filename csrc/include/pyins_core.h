@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 16
+#define PYINS_ABI_VERSION_MINOR 17
 
 #ifdef __cplusplus
 extern "C" {
@@ -93,7 +93,8 @@ enum pyins_status {
                                          ref_max_latency_ticks before the current tick */
     PYINS_E_REF_FUTURE = -42,         /* a reference more than 10 s ahead of the current tick */
     PYINS_E_REF_FULL = -43,           /* the reference queue is full (step the samples it waits for first) */
-    PYINS_E_REF_UNUSED = -44,         /* nav_mode UNDAMPED: the firmware takes no references */
+    PYINS_E_REF_UNUSED = -44,         /* nav_mode UNDAMPED: the firmware takes no references; DAMPED: no
+                                         GNSS position (ABI 0.17) */
     PYINS_W_SEQ_GAP = 1,              /* seq skipped 1..seq_max_gap_ticks ticks: bridged (navigation) or alignment restarted */
     PYINS_W_SEQ_REPEAT = 2,           /* seq repeated (or up to seq_max_gap_ticks behind): duplicate dropped, state unchanged */
     PYINS_W_SEQ_LOST = 3,             /* seq jumped beyond the bridgeable gap: taken without bridging, sequence resynchronised */
@@ -198,9 +199,13 @@ enum pyins_nav_mode {
                                      the filter's covariance running throughout */
     PYINS_NAV_UNDAMPED = 1,       /* free inertial navigation (the firmware of ABI 0.14): no filter,
                                      references refused (PYINS_E_REF_UNUSED) */
-    PYINS_NAV_DAMPED = 2,         /* reported only (AUTO, INTEGRATED): the speed log the only reference
-                                     in use, on a straight course: the horizontal channels damped by
-                                     it; the position is dead reckoning */
+    PYINS_NAV_DAMPED = 2,         /* reported (AUTO, INTEGRATED): the speed log the only reference in
+                                     use, on a straight course: the horizontal channels damped by it;
+                                     the position is dead reckoning. As config (ABI 0.17): level
+                                     damping only, never a filter correction, by the first reference
+                                     velocity in use in the order GNSS velocity, log (on a straight
+                                     course), DVL, zero velocity; GNSS position refused
+                                     (PYINS_E_REF_UNUSED); UNDAMPED reported while none is in use */
     PYINS_NAV_INTEGRATED = 3      /* the error-state Kalman filter corrects attitude, velocity,
                                      position and the IMU biases from the references */
 };

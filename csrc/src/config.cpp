@@ -281,7 +281,7 @@ int config_check(const pyins_config& raw) {
         return PYINS_E_CONFIG_INTEGRITY;
     }
     if ((cfg.nav_mode != PYINS_NAV_AUTO && cfg.nav_mode != PYINS_NAV_UNDAMPED &&
-         cfg.nav_mode != PYINS_NAV_INTEGRATED) ||
+         cfg.nav_mode != PYINS_NAV_DAMPED && cfg.nav_mode != PYINS_NAV_INTEGRATED) ||
         cfg.nav_every_ticks < 1 || cfg.nav_every_ticks > kMaxNavEveryS * cfg.tick_hz ||
         !(cfg.nav_gate > 0.0) || !std::isfinite(cfg.nav_gate) || cfg.nav_reject_limit < 1 ||
         cfg.ref_max_latency_ticks < 1 || cfg.ref_max_latency_ticks > kRefHorizonS * cfg.tick_hz) {

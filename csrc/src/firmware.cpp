@@ -94,6 +94,8 @@ void Firmware::init(const pyins_config& raw) {
         ref_seen_value_[i][1] = 0.0;
         ref_seen_vel_[i][0] = 0.0;
         ref_seen_vel_[i][1] = 0.0;
+        damp_ref_[i][0] = 0.0;
+        damp_ref_[i][1] = 0.0;
     }
     reserved_ref_ = 0;
     log_speed_ = 0.0;
@@ -186,12 +188,15 @@ Quat Firmware::ship_quat() const {
     return attitude::quat_mul_z(sd_.nav.quat_np, enc_cos_half_, -enc_sin_half_);
 }
 
-void Firmware::bow_n(double* east, double* north) const {
+void Firmware::bow_n(double* east, double* north, double* horizontal) const {
     // C_b^n = C_p^n C_b^p; its column 1 (the bow) is (C01, C11, C21)
     const Quat q_nb = ship_quat();
     const double c01 = 2.0 * (q_nb.x * q_nb.y - q_nb.w * q_nb.z);
     const double c11 = q_nb.w * q_nb.w - q_nb.x * q_nb.x + q_nb.y * q_nb.y - q_nb.z * q_nb.z;
     const double h = pmath::sqrt(c01 * c01 + c11 * c11);
+    if (horizontal != nullptr) {
+        *horizontal = h;
+    }
     *east = 0.0;    // (a vertical bow: no horizontal direction)
     *north = 0.0;
     if (h > 0.0) {

@@ -61,6 +61,10 @@ inline constexpr int32_t kStraightS = 10;
 /// waits for the mean: one reading would carry the yaw swing of the moment
 /// (a few degrees at 8 m/s is 0.5 m/s across the bow).
 inline constexpr int32_t kCurrentReadings = 60;
+/// The log reads along the hull's fore-aft axis: a reading is taken only
+/// while that axis's horizontal part (cos pitch) is above this (pitch under
+/// 60 deg; a ship never pitches so: a log or an attitude that is wrong).
+inline constexpr double kLogMinHorizontal = 0.5;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -192,8 +196,10 @@ class Firmware {
     /// the encoder angle (q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)]).
     Quat ship_quat() const;
     /// The bow's horizontal direction in n (E, N; unit), from C_b^n's column
-    /// 1; (0, 0) for a vertical bow.
-    void bow_n(double* east, double* north) const;
+    /// 1; (0, 0) for a vertical bow. ``horizontal``, when given: the length
+    /// of the column's horizontal part, the cosine of the bow's elevation
+    /// (the ship's pitch).
+    void bow_n(double* east, double* north, double* horizontal = nullptr) const;
     /// Sine and cosine of the IMU yaw psi_p = psi_b + alpha (docs/design.md
     /// §2) from the current solution, without taking the angle.
     void imu_yaw_sincos(double* sin_yaw_p, double* cos_yaw_p) const;
@@ -254,6 +260,10 @@ class Firmware {
     void apply_ref(const pyins_ref& ref, int64_t lag);
     /// The navigation mode in effect (pyins_output.nav_mode).
     int32_t nav_mode_now() const;
+    /// The reference that damps (nav_mode DAMPED): the first in use in the
+    /// override order GNSS velocity, the log (on a straight course, the
+    /// current learnt), the DVL, zero velocity; 0 if none.
+    int32_t damp_ref_kind() const;
     /// ref_in_use's bits.
     uint32_t refs_in_use() const;
 
@@ -320,7 +330,7 @@ class Firmware {
     double ref_seen_value_[kRefKinds][2]; ///< its value[0], value[1]
     double ref_seen_vel_[kRefKinds][2];   ///< the reference point's velocity then (E, N) [m/s]
     // Level damping by the speed log (damp_interval, apply_log).
-    double log_speed_;            ///< the last log reading used [m/s] (speed through water, bow)
+    double log_speed_;            ///< the last log reading used, its horizontal part [m/s] (apply_log)
     double current_n_[2];         ///< the water current learnt, v - v_log bow (E, N) [m/s]
     double bow_last_[2];          ///< the bow's direction at the last interval (E, N)
     double turn_rate_f_;          ///< the bow's turn rate, low-passed [rad/s]
@@ -329,6 +339,9 @@ class Firmware {
     int32_t straight_s_;          ///< seconds of straight course (saturates at kStraightS)
     int32_t bow_known_;           ///< 1: bow_last_ holds a value
     int32_t damp_on_;             ///< 1: the last interval damped
+    /// nav_mode DAMPED: the reference point's ground velocity (E, N) [m/s]
+    /// by the last reference used of each kind (the log's is v_log b + c)
+    double damp_ref_[kRefKinds][2];
 };
 
 }  // namespace pyins::firmware

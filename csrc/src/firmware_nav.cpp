@@ -97,7 +97,10 @@ void Firmware::nav_tick(const Vec3& dv_sf_n) {
 }
 
 int Firmware::push_ref(const pyins_ref& ref) {
-    if (cfg_.nav_mode == PYINS_NAV_UNDAMPED) {
+    // UNDAMPED takes no reference; DAMPED no position (its position is
+    // dead reckoning: a fix would be a reset, which is INTEGRATED's)
+    if (cfg_.nav_mode == PYINS_NAV_UNDAMPED ||
+        (cfg_.nav_mode == PYINS_NAV_DAMPED && ref.kind == PYINS_REF_GNSS_POS)) {
         return PYINS_E_REF_UNUSED;
     }
     // a DVL's reserved field marks its track: bottom track (0) alone is used
@@ -190,25 +193,38 @@ void Firmware::ref_point_vel(double* east, double* north) const {
 void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     // The EM log: speed through water along the bow, v_log. A damping
     // reference, not a filter measurement: the ground velocity it stands for
-    // is v_log b + c, b the bow's horizontal direction, c the current (and
+    // is v_h b + c, v_h the reading's horizontal part (below), b the bow's
+    // horizontal direction, c the current (and
     // the ship's sideslip) learnt where the velocity is known.
     double be;
     double bn;
-    bow_n(&be, &bn);
+    double hb;
+    bow_n(&be, &bn, &hb);
+    // The log reads the water's velocity along the hull's fore-aft axis,
+    // which pitches: v_x = v_h cos(theta) + v_z sin(theta). Its horizontal
+    // part is v_x / cos(theta), cos(theta) the bow's horizontal length by
+    // the INS's own attitude; the vertical share v_z tan(theta) (heave at
+    // the waves' pitch) averages out. Uncompensated, 2.8 deg of pitch swing
+    // reads 0.12 % low (7 mm/s at 12 kn: 0.6 km a day along the track,
+    // docs/results/damping_72h.md).
+    if (!(hb > kLogMinHorizontal)) {
+        reject_ref(slot);
+        return;
+    }
     double ve;
     double vn;
     ref_point_vel(&ve, &vn);
-    const double v_log = ref.value[0];
+    const double v_h = ref.value[0] / hb;
     if (current_known_ == 0) {
         // the first reading: the velocity now stands for the current (the
         // gate's reference until the mean is made)
-        current_n_[0] = ve - v_log * be;
-        current_n_[1] = vn - v_log * bn;
+        current_n_[0] = ve - v_h * be;
+        current_n_[1] = vn - v_h * bn;
     }
     // gate: the innovation along the bow against the log's sigma and the
     // filter's velocity variance there (chi-square, 1 degree of freedom,
     // tested against nav_gate)
-    const double innov = (ve - current_n_[0]) * be + (vn - current_n_[1]) * bn - v_log;
+    const double innov = (ve - current_n_[0]) * be + (vn - current_n_[1]) * bn - v_h;
     const int32_t kv = nav_filter::kVel;
     const double pvv = nav_.p(kv, kv) * be * be + 2.0 * nav_.p(kv, kv + 1) * be * bn + nav_.p(kv + 1, kv + 1) * bn * bn;
     const double nis = innov * innov / (ref.sigma[0] * ref.sigma[0] + pvv);
@@ -218,7 +234,7 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
         return;
     }
     use_ref(slot);
-    log_speed_ = v_log;
+    log_speed_ = v_h;
     // the current: the mean of the first kCurrentReadings readings, then a
     // low-pass while the velocity is known (GNSS velocity or zero velocity
     // or a DVL's bottom track in use), else held (firmware.hpp)
@@ -231,8 +247,8 @@ void Firmware::apply_log(const pyins_ref& ref, int32_t slot) {
     } else if ((refs_in_use() & known) == 0u) {
         return;
     }
-    current_n_[0] = current_n_[0] + (ve - v_log * be - current_n_[0]) / n;
-    current_n_[1] = current_n_[1] + (vn - v_log * bn - current_n_[1]) / n;
+    current_n_[0] = current_n_[0] + (ve - v_h * be - current_n_[0]) / n;
+    current_n_[1] = current_n_[1] + (vn - v_h * bn - current_n_[1]) / n;
 }
 
 Vec3 Firmware::point_vel_n(const Quat& q_nb, const double* l) const {
@@ -346,8 +362,16 @@ void Firmware::damp_interval() {
     double ve;
     double vn;
     ref_point_vel(&ve, &vn);
-    const double e_e = ve - (log_speed_ * be + current_n_[0]);
-    const double e_n = vn - (log_speed_ * bn + current_n_[1]);
+    // v_ref: the log's v_h b + c, or the damping reference's (damp_ref_kind)
+    const int32_t kind = damp_ref_kind();
+    double re = log_speed_ * be + current_n_[0];
+    double rn = log_speed_ * bn + current_n_[1];
+    if (kind != PYINS_REF_SPEED_LOG) {
+        re = damp_ref_[kind - 1][0];
+        rn = damp_ref_[kind - 1][1];
+    }
+    const double e_e = ve - re;
+    const double e_n = vn - rn;
     damp_int_[0] = damp_int_[0] + k3 * t * e_e;
     damp_int_[1] = damp_int_[1] + k3 * t * e_n;
     const Vec3 dphi(-(k2 * e_n + damp_int_[1]) * t / m.rm_h, (k2 * e_e + damp_int_[0]) * t / m.rn_h, 0.0);
@@ -382,6 +406,7 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     const bool antenna = (ref.kind == PYINS_REF_GNSS_POS || ref.kind == PYINS_REF_GNSS_VEL) &&
                          (la[0] != 0.0 || la[1] != 0.0 || la[2] != 0.0);
     Vec3 ant_n = Vec3::Zero();
+    const Vec3 vel_rp = vel;
     if (antenna) {
         const Quat q_nb = ship_quat();
         ant_n = attitude::quat_to_mat(q_nb) * Vec3(la[0], la[1], la[2]);
@@ -460,6 +485,14 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         return;
     }
     use_ref(slot);
+    if (cfg_.nav_mode == PYINS_NAV_DAMPED) {
+        // a damping reference, not a filter measurement: the reference
+        // point's ground velocity it stands for (z = computed - reference,
+        // the antenna's velocity less its lever arm's share)
+        damp_ref_[slot][0] = vel_rp(0) - z[0];
+        damp_ref_[slot][1] = vel_rp(1) - z[1];
+        return;
+    }
     nav_filter::update_pair(nav_, k, z, r);
     if (nav_.healthy == 0) {
         faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
@@ -481,6 +514,10 @@ int32_t Firmware::nav_mode_now() const {
     if (mode_ != Mode::kNavigate) {
         return 0;
     }
+    if (cfg_.nav_mode == PYINS_NAV_DAMPED) {
+        return damp_ref_kind() != 0 ? static_cast<int32_t>(PYINS_NAV_DAMPED)
+                                    : static_cast<int32_t>(PYINS_NAV_UNDAMPED);
+    }
     const uint32_t in_use = nav_on_ != 0 ? refs_in_use() : 0u;
     const uint32_t log = 1u << (PYINS_REF_SPEED_LOG - 1);
     if ((in_use & ~log) != 0u) {
@@ -491,6 +528,28 @@ int32_t Firmware::nav_mode_now() const {
         return static_cast<int32_t>(PYINS_NAV_DAMPED);
     }
     return static_cast<int32_t>(PYINS_NAV_UNDAMPED);
+}
+
+int32_t Firmware::damp_ref_kind() const {
+    // The classic marine override order (docs/concepts.md, "At sea"): the
+    // reference velocity of a level-damped INS taken from GNSS, else the
+    // EM log, else the DVL's bottom track, else zero velocity. The log
+    // damps only on a straight course with the current learnt (a turn's
+    // sideslip biases it; the current is what turns speed through water
+    // into velocity over ground).
+    const uint32_t in_use = nav_on_ != 0 ? refs_in_use() : 0u;
+    const int32_t order[4] = {PYINS_REF_GNSS_VEL, PYINS_REF_SPEED_LOG, PYINS_REF_DVL, PYINS_REF_ZERO_VEL};
+    for (int32_t i = 0; i < 4; ++i) {
+        const int32_t kind = order[i];
+        if ((in_use & (1u << (kind - 1))) == 0u) {
+            continue;
+        }
+        if (kind == PYINS_REF_SPEED_LOG && (straight_s_ < kStraightS || current_known_ < kCurrentReadings)) {
+            continue;
+        }
+        return kind;
+    }
+    return 0;
 }
 
 uint32_t Firmware::refs_in_use() const {

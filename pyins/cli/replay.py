@@ -418,6 +418,12 @@ def _feed(args, cfg, hz):
     if parts:
         refs = np.concatenate(parts) if len(parts) > 1 else parts[0]
         refs = refs[np.argsort(refs["tick"], kind="stable")]
+        pos = refs["kind"] == contract.REF_KINDS["gnss_pos"]
+        if cfg.get("nav_mode") == abi.PYINS_NAV_DAMPED and np.any(pos):
+            raise InputError(f"{'/'.join(given)}: {np.count_nonzero(pos)} GNSS position fixes, and the "
+                             "scenario sets firmware.nav_mode = \"damped\", which takes none (its position "
+                             "is dead reckoning): give velocity fixes alone (--refs with gnss_vel rows) or "
+                             "another nav_mode")
     _dvl_mounting(args, cfg, mounting, refs)
     _gnss_lever(args, cfg, refs)
     if args.zero_velocity is not None:

@@ -315,7 +315,8 @@ def config_check(raw):
             or not (wander > 0.0) or not math.isfinite(wander)):
         return abi.PYINS_E_CONFIG_INTEGRITY
     hz = cfg["tick_hz"]
-    if (cfg["nav_mode"] not in (abi.PYINS_NAV_AUTO, abi.PYINS_NAV_UNDAMPED, abi.PYINS_NAV_INTEGRATED)
+    if (cfg["nav_mode"] not in (abi.PYINS_NAV_AUTO, abi.PYINS_NAV_UNDAMPED, abi.PYINS_NAV_DAMPED,
+                               abi.PYINS_NAV_INTEGRATED)
             or not 1 <= cfg["nav_every_ticks"] <= MAX_NAV_EVERY_S * hz
             or not (cfg["nav_gate"] > 0.0) or not math.isfinite(cfg["nav_gate"])
             or cfg["nav_reject_limit"] < 1

@@ -153,16 +153,16 @@ class Firmware(NavAtSea):
         """q_nb = q_np q_pb, q_pb = [cos(alpha/2), 0, 0, -sin(alpha/2)] (mirrors ship_quat)."""
         return attitude.quat_mul_z(self.sd.nav.quat_np, self.enc_cos_half, -self.enc_sin_half)
 
-    def bow_n(self):
+    def bow_n(self, horizontal=False):
         """The bow's horizontal direction in n (E, N; unit): C_b^n's column 1;
-        (0, 0) for a vertical bow (mirrors bow_n)."""
+        (0, 0) for a vertical bow; with ``horizontal`` also the length of the
+        column's horizontal part, cos(pitch) (mirrors bow_n)."""
         w, x, y, z = self.ship_quat()
         c01 = 2.0 * (x * y - w * z)
         c11 = w * w - x * x + y * y - z * z
         h = math.sqrt(c01 * c01 + c11 * c11)
-        if h > 0.0:
-            return c01 / h, c11 / h
-        return 0.0, 0.0
+        be, bn = (c01 / h, c11 / h) if h > 0.0 else (0.0, 0.0)
+        return (be, bn, h) if horizontal else (be, bn)
 
     def imu_yaw_sincos(self):
         """sin and cos of psi_p = psi_b + alpha, no angle taken (mirrors

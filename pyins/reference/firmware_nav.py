@@ -20,6 +20,7 @@ TURN_TAU = 20.0                         #: kTurnTau [s]
 STRAIGHT_RATE = 0.3 * math.pi / 180.0   #: kStraightRate [rad/s]
 STRAIGHT_S = 10                         #: kStraightS
 CURRENT_READINGS = 60                   #: kCurrentReadings
+LOG_MIN_HORIZONTAL = 0.5                #: kLogMinHorizontal
 U32 = 0xFFFFFFFF
 
 
@@ -59,6 +60,7 @@ class NavAtSea:
         self.straight_s = 0
         self.bow_known = 0
         self.damp_on = 0
+        self.damp_ref = [(0.0, 0.0)] * REF_KINDS
 
     def start_nav_filter(self):
         cfg = self.cfg
@@ -130,12 +132,16 @@ class NavAtSea:
 
     def apply_log(self, value, sigma, slot):
         """The EM log: a damping reference, not a filter measurement (mirrors apply_log)."""
-        be, bn = self.bow_n()
+        be, bn, hb = self.bow_n(horizontal=True)
+        # the log reads along the pitching hull axis: its horizontal part (mirrors apply_log)
+        if not hb > LOG_MIN_HORIZONTAL:
+            self.reject_ref(slot)
+            return
         ve, vn = self.ref_point_vel()
-        v_log = value[0]
+        v_h = value[0] / hb
         if self.current_known == 0:
-            self.current_n = [ve - v_log * be, vn - v_log * bn]
-        innov = (ve - self.current_n[0]) * be + (vn - self.current_n[1]) * bn - v_log
+            self.current_n = [ve - v_h * be, vn - v_h * bn]
+        innov = (ve - self.current_n[0]) * be + (vn - self.current_n[1]) * bn - v_h
         p = self.nav.p
         kv = nav_filter.VEL
         pvv = p[kv, kv] * be * be + 2.0 * p[kv, kv + 1] * be * bn + p[kv + 1, kv + 1] * bn * bn
@@ -145,7 +151,7 @@ class NavAtSea:
             self.reject_ref(slot)
             return
         self.use_ref(slot)
-        self.log_speed = v_log
+        self.log_speed = v_h
         known = ((1 << (abi.PYINS_REF_GNSS_VEL - 1)) | (1 << (abi.PYINS_REF_DVL - 1))
                  | (1 << (abi.PYINS_REF_ZERO_VEL - 1)))
         n = float(CURRENT_READINGS)
@@ -154,8 +160,8 @@ class NavAtSea:
             n = float(self.current_known)
         elif not self.refs_in_use() & known:
             return
-        self.current_n = [self.current_n[0] + (ve - v_log * be - self.current_n[0]) / n,
-                          self.current_n[1] + (vn - v_log * bn - self.current_n[1]) / n]
+        self.current_n = [self.current_n[0] + (ve - v_h * be - self.current_n[0]) / n,
+                          self.current_n[1] + (vn - v_h * bn - self.current_n[1]) / n]
 
     def point_vel_n(self, q_nb, lv):
         """How much faster than the reference point a point at the lever arm lv
@@ -212,8 +218,13 @@ class NavAtSea:
         k2 = 2.0 * DAMPING_RATIO
         k3 = w_s
         ve, vn = self.ref_point_vel()
-        e_e = ve - (self.log_speed * be + self.current_n[0])
-        e_n = vn - (self.log_speed * bn + self.current_n[1])
+        # v_ref: the log's v_h b + c, or the damping reference's (damp_ref_kind)
+        kind = self.damp_ref_kind()
+        re, rn = self.log_speed * be + self.current_n[0], self.log_speed * bn + self.current_n[1]
+        if kind != abi.PYINS_REF_SPEED_LOG:
+            re, rn = self.damp_ref[kind - 1]
+        e_e = ve - re
+        e_n = vn - rn
         self.damp_int = [self.damp_int[0] + k3 * t * e_e, self.damp_int[1] + k3 * t * e_n]
         dphi = np.array([-(k2 * e_n + self.damp_int[1]) * t / m.rm_h, (k2 * e_e + self.damp_int[0]) * t / m.rn_h,
                          0.0])
@@ -225,7 +236,9 @@ class NavAtSea:
     def push_ref(self, kind, tick, value, sigma, reserved=0):
         """One reference; PYINS_OK or a PYINS_E_REF_* status (mirrors push_ref)."""
         cfg = self.cfg
-        if cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED:
+        # UNDAMPED takes no reference; DAMPED no position (mirrors push_ref)
+        if (cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED
+                or (cfg["nav_mode"] == abi.PYINS_NAV_DAMPED and kind == abi.PYINS_REF_GNSS_POS)):
             return abi.PYINS_E_REF_UNUSED
         # a DVL's reserved field marks its track: bottom track (0) alone is used
         dvl = kind == abi.PYINS_REF_DVL
@@ -284,6 +297,7 @@ class NavAtSea:
         antenna = (kind in (abi.PYINS_REF_GNSS_POS, abi.PYINS_REF_GNSS_VEL)
                    and (la[0] != 0.0 or la[1] != 0.0 or la[2] != 0.0))
         ant_n = np.zeros(3)
+        vel_rp = vel.copy()
         if antenna:
             q_nb = self.ship_quat()
             ant_n = attitude.quat_to_mat(q_nb) @ np.array([la[0], la[1], la[2]], dtype=float)
@@ -335,6 +349,10 @@ class NavAtSea:
             self.reject_ref(slot)
             return
         self.use_ref(slot)
+        if self.cfg["nav_mode"] == abi.PYINS_NAV_DAMPED:
+            # a damping reference: the reference point's ground velocity it stands for
+            self.damp_ref[slot] = (float(vel_rp[0] - z[0]), float(vel_rp[1] - z[1]))
+            return
         nav_filter.update_pair(self.nav, k, z, r)
         if self.nav.healthy == 0:
             self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
@@ -351,6 +369,8 @@ class NavAtSea:
     def nav_mode_now(self):
         if self.mode != abi.PYINS_MODE_NAVIGATE:
             return 0
+        if self.cfg["nav_mode"] == abi.PYINS_NAV_DAMPED:
+            return abi.PYINS_NAV_DAMPED if self.damp_ref_kind() != 0 else abi.PYINS_NAV_UNDAMPED
         in_use = self.refs_in_use() if self.nav_on else 0
         log = 1 << (abi.PYINS_REF_SPEED_LOG - 1)
         if in_use & ~log:
@@ -358,6 +378,20 @@ class NavAtSea:
         if in_use & log and self.straight_s >= STRAIGHT_S and self.current_known >= CURRENT_READINGS:
             return abi.PYINS_NAV_DAMPED
         return abi.PYINS_NAV_UNDAMPED
+
+    def damp_ref_kind(self):
+        """The reference that damps in nav_mode DAMPED, by the override order
+        GNSS velocity, log (straight course, current learnt), DVL, zero
+        velocity; 0 if none (mirrors damp_ref_kind)."""
+        in_use = self.refs_in_use() if self.nav_on else 0
+        for kind in (abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_SPEED_LOG, abi.PYINS_REF_DVL, abi.PYINS_REF_ZERO_VEL):
+            if not in_use & (1 << (kind - 1)):
+                continue
+            if kind == abi.PYINS_REF_SPEED_LOG and (self.straight_s < STRAIGHT_S
+                                                    or self.current_known < CURRENT_READINGS):
+                continue
+            return kind
+        return 0
 
     def refs_in_use(self):
         window = REF_IN_USE_S * self.cfg["tick_hz"]

@@ -353,7 +353,7 @@ def _references(res, motion):
                                      vel_noise_mps=g["vel_noise_mps"], bias_sigma_m=g["bias_sigma_m"],
                                      bias_tau_s=g["bias_tau_s"], latency_s=g["latency_s"], outages=outages,
                                      outlier_rate=g["outlier_rate"], frozen=[tuple(w) for w in g["frozen"]],
-                                     seed=g["seed"], velocity=g["velocity"], lever_b=tuple(g["lever_m"])))
+                                     seed=g["seed"], velocity=g["velocity"], position=g["position"], lever_b=tuple(g["lever_m"])))
     lg = rt.get("speed_log")
     if lg is not None:
         # the water the ship moves in: a voyage's current (another motion: still water)

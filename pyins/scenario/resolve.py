@@ -338,6 +338,13 @@ def _resolve_references(table, duration_s, firmware):
                 raise ScenarioError(f"{v[rate_key]:g} Hz: 1 / rate must be a whole number of ticks "
                                     f"({DT:g} s)", f"{path}.{rate_key}")
         if name == "gnss":
+            if not (v["position"] or v["velocity"]):
+                raise ScenarioError("position and velocity are both false: the receiver gives no fixes",
+                                    f"{path}.position")
+            if v["position"] and firmware.get("nav_mode") == "damped":
+                raise ScenarioError("nav_mode = 'damped' takes no GNSS position (its position is dead "
+                                    "reckoning; a fix would reset it, which is 'integrated'): set "
+                                    "references.gnss.position = false", f"{path}.position")
             v["outages"] = _windows(v["outages"], f"{path}.outages", duration_s)
             v["frozen"] = _windows(v["frozen"], f"{path}.frozen", duration_s)
             if v["outage_every"] and v["outage_length"] >= v["outage_every"]:

@@ -245,7 +245,7 @@ STEP_KEYS = {
 
 #: the firmware's enums by the names scenario files and the CLI use
 NAV_MODES = {"auto": abi.PYINS_NAV_AUTO, "undamped": abi.PYINS_NAV_UNDAMPED,
-             "integrated": abi.PYINS_NAV_INTEGRATED}
+             "damped": abi.PYINS_NAV_DAMPED, "integrated": abi.PYINS_NAV_INTEGRATED}
 VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
 FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
 FINE_NOISES = {"measured": abi.PYINS_FINE_NOISE_MEASURED, "configured": abi.PYINS_FINE_NOISE_CONFIGURED}
@@ -297,9 +297,10 @@ FIRMWARE_KEYS = {
     "fine_sigma0_accel": Key("acceleration", "initial sigma of the biases (firmware default "
                                              "100 ug)", lo="0 ug", hi="1 g", lo_open=True),
     "nav_mode": Key("choice", "navigation: 'auto' (integrated while a reference is in use, else "
-                              "undamped), 'undamped' (free inertial, references refused) or "
-                              "'integrated' (firmware default auto)", choices=("auto", "undamped",
-                                                                               "integrated")),
+                              "undamped), 'undamped' (free inertial, references refused), 'damped' "
+                              "(level damping by a reference velocity, no filter corrections, no GNSS "
+                              "position) or 'integrated' (firmware default auto)",
+                    choices=("auto", "undamped", "damped", "integrated")),
     "fine_site_accel": Key("velocity_random_walk", "moving base (fine_states 12): the site's slow "
                                                    "horizontal motion, a ship ranging on its lines, as "
                                                    "a white acceleration density (firmware default 0: "
@@ -376,6 +377,8 @@ GNSS_KEYS = {
     "frozen": Key("tables", "a frozen receiver {start, end}: the last fix before start repeated"),
     "seed": Key("int", "seed of the receiver's noise (not the IMU's)", default=0, lo=0),
     "velocity": Key("bool", "give velocity fixes beside the positions", default=True),
+    "position": Key("bool", "give position fixes (firmware.nav_mode 'damped' takes none: false there)",
+                    default=True),
     "lever": Key("length", "reference point -> the antenna [x starboard, y bow, z up]: the fixes are the "
                            "antenna's", "0 m", lo="-100 m", hi="100 m", shape=3),
     "lever_told": Key("length", "the antenna's lever arm the firmware is told (its gnss_lever_b_m; "

@@ -254,7 +254,7 @@ def _in_windows(t, windows):
 def gnss(motion, duration_s, dt=DT, rate_hz=1.0, lever_b=(0.0, 0.0, 0.0),
          pos_noise_m=(3.0, 3.0, 5.0), vel_noise_mps=0.05, bias_sigma_m=2.0,
          bias_tau_s=300.0, latency_s=0.0, outages=(), outlier_rate=0.0,
-         outlier_m=(50.0, 500.0), frozen=(), offsets=(), seed=0, velocity=True):
+         outlier_m=(50.0, 500.0), frozen=(), offsets=(), seed=0, velocity=True, position=True):
     """GNSS position (and velocity) fixes of an antenna at ``lever_b`` [m, b].
 
     Errors as in the module docstring. ``pos_noise_m`` and ``bias_sigma_m``
@@ -264,8 +264,11 @@ def gnss(motion, duration_s, dt=DT, rate_hz=1.0, lever_b=(0.0, 0.0, 0.0),
     dN, dU)) [s, m]; ``outlier_m`` = (min, max) jump [m]. ``latency_s`` (a
     whole number of ticks) only delays ``avail_tick``. The random draws do
     not depend on the fault settings: the same seed gives the same noise.
-    Returns References: GNSS_POS and, when ``velocity``, GNSS_VEL records.
+    Returns References: GNSS_POS records when ``position``, GNSS_VEL records
+    when ``velocity`` (the draws the same either way).
     """
+    if not (position or velocity):
+        raise ValueError("gnss: position and velocity both False: no fixes")
     ticks = schedule(duration_s, rate_hz, dt)
     pos_t, vel_t, _, t = antenna(motion, ticks, lever_b, dt)
     n = len(ticks)
@@ -306,10 +309,11 @@ def gnss(motion, duration_s, dt=DT, rate_hz=1.0, lever_b=(0.0, 0.0, 0.0),
 
     lat_ticks = _to_ticks("latency_s", latency_s, dt)
     sig_p = np.sqrt(noise_p ** 2 + bias_s ** 2)
+    vel_out = _records(KIND_GNSS_VEL, ticks, vel, noise_v, vel_t, lat_ticks) if velocity else None
+    if not position:
+        return vel_out
     out = _records(KIND_GNSS_POS, ticks, pos, sig_p, pos_t, lat_ticks)
-    if velocity:
-        out = merge(out, _records(KIND_GNSS_VEL, ticks, vel, noise_v, vel_t, lat_ticks))
-    return out
+    return merge(out, vel_out) if velocity else out
 
 
 def speed_log(motion, duration_s, current, rate_hz=1.0, scale_factor=0.005, bias_mps=0.0,

@@ -15,7 +15,7 @@ noise and a 0.5 % scale factor, told 0.1 m/s. Measured on the landed code
 
     unaided:  the north velocity error's Schuler oscillation 0.97 m/s
               (84-min band of its spectrum), 4.4 km after 4 h
-    damped:   0.067 m/s in the same band (14x smaller), 671 m after 4 h:
+    damped:   0.064 m/s in the same band (15x smaller), 791 m after 4 h:
               the log's scale factor (0.5 % of 8-10 m/s along the track),
               the tide's change since the current was learnt, and the
               INS's own velocity error of that first minute, which the

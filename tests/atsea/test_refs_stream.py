@@ -76,9 +76,12 @@ def _same_records(a, b):
 
 
 @settings(max_examples=60, deadline=None)
-@given(ops=_ops, undamped=st.booleans())
-def test_streams_of_references_in_both_engines(ops, undamped):
-    cfg = {"lat_rad": LAT, **({"nav_mode": abi.PYINS_NAV_UNDAMPED} if undamped else {})}
+@given(ops=_ops, nav_mode=st.sampled_from([abi.PYINS_NAV_AUTO, abi.PYINS_NAV_AUTO, abi.PYINS_NAV_UNDAMPED,
+                                            abi.PYINS_NAV_DAMPED]))
+def test_streams_of_references_in_both_engines(ops, nav_mode):
+    cfg = {"lat_rad": LAT, "nav_mode": nav_mode}
+    undamped = nav_mode == abi.PYINS_NAV_UNDAMPED
+    damped = nav_mode == abi.PYINS_NAV_DAMPED
     fws = [engine.firmware(e, cfg) for e in ("native", "reference")]
     for fw in fws:
         fw.run(_static(50))
@@ -94,6 +97,11 @@ def test_streams_of_references_in_both_engines(ops, undamped):
                 assert np.all(np.isfinite(out["nav_sigma_pos_m"])) and np.all(out["nav_sigma_pos_m"] > 0.0)
                 assert np.all(np.isfinite(out["nav_sigma_heading_rad"]))
                 assert np.all(out["nav_sigma_heading_rad"] > 0.0)
+            if damped:
+                # never a filter correction; DAMPED only while a velocity reference is in use
+                assert not np.any(out["nav_mode"] == abi.PYINS_NAV_INTEGRATED)
+                assert not np.any(out["nav_gyro_bias_rad_s"])
+                assert np.all((out["nav_mode"] == abi.PYINS_NAV_DAMPED) <= (out["ref_in_use"] != 0))
             continue
         if op[0] == "fix":
             _, kind, ahead, style, steps = op
@@ -124,7 +132,7 @@ def test_streams_of_references_in_both_engines(ops, undamped):
                 assert fw.snapshot() == before, e.status_name       # refused: nothing changed
         assert got[0] == got[1], (op, got)
         # the refusals a push must get, whatever came before
-        if undamped:
+        if undamped or (damped and kind == 1):
             assert got[0] == "PYINS_E_REF_UNUSED"
         elif kind not in (1, 2, 3, 4, 5):
             assert got[0] == "PYINS_E_REF_KIND"

@@ -115,7 +115,10 @@ rate = "2 Hz"
     ('[references.gnss]\npos_noise = "0 m"\n', "references.gnss.pos_noise", "out of range"),
     ('[references.zero_velocity]\nsigma = "0 m/s"\n', "references.zero_velocity.sigma", "out of range"),
     ('[firmware]\nnav_mode = "undamped"\n[references.gnss]\n', "firmware.nav_mode", "takes no references"),
-    ('[firmware]\nnav_mode = "damped"\n', "firmware.nav_mode", "one of"),
+    ('[firmware]\nnav_mode = "damping"\n', "firmware.nav_mode", "one of"),
+    ('[firmware]\nnav_mode = "damped"\n[references.gnss]\n', "references.gnss.position",
+     "takes no GNSS position"),
+    ('[references.gnss]\nposition = false\nvelocity = false\n', "references.gnss.position", "no fixes"),
     ('current = "0.2 m/s"\n', "motion.current", "horizontal"),
     ('[references.speed_log]\nsigma = "0 m/s"\n', "references.speed_log.sigma", "out of range"),
     ('[references.dvl]\nsigma = "0 m/s"\n', "references.dvl.sigma", "out of range"),
@@ -198,6 +201,9 @@ def test_an_antenna_lever_arm_that_cannot_be_is_refused_at_its_key():
 
 def test_nav_mode_goes_to_the_firmware():
     assert _spec(VOYAGE + '[firmware]\nnav_mode = "integrated"\n').config["nav_mode"] == abi.PYINS_NAV_INTEGRATED
+    damped = _spec(VOYAGE + '[firmware]\nnav_mode = "damped"\n' + GNSS + 'position = false\n')
+    assert damped.config["nav_mode"] == abi.PYINS_NAV_DAMPED
+    assert np.all(damped.refs["kind"] == abi.PYINS_REF_GNSS_VEL) and len(damped.refs) == 600
     assert "nav_mode" not in _spec(VOYAGE).config
     assert "nav_mode" not in scenario.loads(VOYAGE).resolved()["firmware"]   # (older files' digests)
 
@@ -313,3 +319,28 @@ def test_simulate_writes_the_references_and_replay_takes_them(tmp_path, capsys):
     capsys.readouterr()
     assert cli.main(["simulate", str(plain), str(tmp_path / "p.npz"), "--refs", str(tmp_path / "r.csv")]) == 2
     assert "--refs" in capsys.readouterr().err and not (tmp_path / "p.npz").exists()
+
+
+def test_a_damped_scenario_replays_with_gnss_velocity_and_refuses_positions(tmp_path, capsys):
+    """nav_mode = "damped": `pyins simulate` writes velocity fixes alone
+    (references.gnss.position = false) and `pyins replay` takes them; given
+    a file with position fixes, replay refuses before the log runs (the
+    firmware would refuse them: PYINS_E_REF_UNUSED), exit 2, naming both."""
+    base = VOYAGE + '[sensors]\npreset = "seed002"\n[firmware]\nfine_sigma0_att = ["1 arcmin", "1 arcmin", "10 arcmin"]\n'
+    (tmp_path / "d.toml").write_text(base + 'nav_mode = "damped"\n' + GNSS + "position = false\n")
+    (tmp_path / "a.toml").write_text(base + GNSS)
+    log, refs_csv = tmp_path / "imu.npz", tmp_path / "refs.csv"
+    assert cli.main(["simulate", str(tmp_path / "d.toml"), str(log), "--refs", str(refs_csv), "--quiet"]) == 0
+    assert cli.main(["simulate", str(tmp_path / "a.toml"), str(tmp_path / "a.npz"), "--refs",
+                     str(tmp_path / "pos.csv"), "--quiet"]) == 0
+    out = tmp_path / "damped"
+    assert cli.main(["replay", str(log), "--refs", str(refs_csv), "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    k = s["references"]["kinds"]
+    assert set(k) == {"gnss_vel"} and k["gnss_vel"]["used"] > 590
+    capsys.readouterr()
+    rc = cli.main(["replay", str(log), "--refs", str(tmp_path / "pos.csv"), "--out", str(tmp_path / "x"),
+                   "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--refs" in err and "600 GNSS position fixes" in err and '"damped"' in err
+    assert not (tmp_path / "x" / "summary.json").exists()
