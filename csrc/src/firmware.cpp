@@ -110,6 +110,11 @@ void Firmware::init(const pyins_config& raw) {
     straight_s_ = 0;
     bow_known_ = 0;
     damp_on_ = 0;
+    for (int i = 0; i < 4; ++i) {
+        out_off_[i] = 0.0;
+    }
+    blend_window_ = 0;
+    blend_on_ = 0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)
     coarse_wander_max_ = cfg.integrity_coarse_rad >= 0.5 * kPi ? 1.0 : pmath::sin(cfg.integrity_coarse_rad);
 
@@ -784,6 +789,7 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
             const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p - nav_.gyro_bias * dt_,
                                                    dv_p - nav_.accel_bias * dt_, dt_);
             nav_tick(dv_sf_n);
+            blend_tick();
         } else {
             strapdown::update(sd_, dtheta_p, dv_p, dt_);
         }
@@ -828,6 +834,13 @@ PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* heigh
         vel_n[0] = nav.vel_n(0);
         vel_n[1] = nav.vel_n(1);
         vel_n[2] = nav.vel_n(2);
+    }
+    if (blend_on_ != 0 && mode_ == Mode::kNavigate) {
+        // the bumpless return: the output offset (kBlendWindowS)
+        *lat = *lat + out_off_[0];
+        *lon = wrap_pi(*lon + out_off_[1]);
+        vel_n[0] = vel_n[0] + out_off_[2];
+        vel_n[1] = vel_n[1] + out_off_[3];
     }
 
     // Ship attitude: C_b^n = C_p^n C_b^p, C_b^p = Rz(-alpha), with alpha the
@@ -935,8 +948,17 @@ void Firmware::output(pyins_output* out) const {
         out->nav_nis[i] = nav_nis_[i];
     }
     const bool filter = nav_on_ != 0;
+    // the output's sigma: the filter's, and the output offset's distance
+    // from its estimate while a return is blended (kBlendWindowS)
+    double off2 = 0.0;
+    if (blend_on_ != 0) {
+        double de;
+        double dn;
+        blend_offset_m(&de, &dn);
+        off2 = de * de + dn * dn;
+    }
     out->nav_sigma_pos_m = filter ? pmath::sqrt(nav_.p(nav_filter::kPos, nav_filter::kPos) +
-                                                nav_.p(nav_filter::kPos + 1, nav_filter::kPos + 1))
+                                                nav_.p(nav_filter::kPos + 1, nav_filter::kPos + 1) + off2)
                                   : 0.0;
     out->nav_sigma_heading_rad = filter ? pmath::sqrt(nav_.p(nav_filter::kPhi + 2, nav_filter::kPhi + 2)) : 0.0;
     for (int i = 0; i < 3; ++i) {

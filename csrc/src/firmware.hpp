@@ -65,6 +65,21 @@ inline constexpr int32_t kCurrentReadings = 60;
 /// while that axis's horizontal part (cos pitch) is above this (pitch under
 /// 60 deg; a ship never pitches so: a log or an attitude that is wrong).
 inline constexpr double kLogMinHorizontal = 0.5;
+/// Bumpless return to INTEGRATED (docs/concepts.md, "At sea"): for
+/// kBlendWindowS after a correction that follows a spell without one (an
+/// outage, DAMPED or UNDAMPED, the start of NAVIGATE), the filter's
+/// corrections move the navigation solution as always but are added to an
+/// output offset, so that the output does not jump; the offset then decays
+/// with the time constant kBlendTau, its position part by at most
+/// kBlendSpeed and its velocity part by at most kBlendAccel (the at-sea
+/// bound for a switch: under 1 m and 1 cm/s from one second to the next).
+inline constexpr int32_t kBlendWindowS = 10;
+inline constexpr double kBlendTau = 60.0;      ///< [s]
+inline constexpr double kBlendSpeed = 0.5;     ///< [m/s]
+inline constexpr double kBlendAccel = 0.002;   ///< [m/s^2]
+/// An offset below these is dropped [m], [m/s].
+inline constexpr double kBlendDoneM = 1e-3;
+inline constexpr double kBlendDoneMps = 1e-5;
 /// "PYNS": marks memory that holds an initialised instance.
 inline constexpr uint32_t kMagic = 0x50594E53u;
 
@@ -235,6 +250,10 @@ class Firmware {
     nav_filter::Motion nav_motion() const;
     /// Navigation filter work of a NAVIGATE tick, after the strapdown.
     void nav_tick(const Vec3& dv_sf_n);
+    /// The output offset's decay, once a tick in NAVIGATE (kBlendTau).
+    void blend_tick();
+    /// The output offset's position part in metres (E, N).
+    void blend_offset_m(double* east, double* north) const;
     /// Once a filter interval in NAVIGATE: the course's turn rate and, in
     /// DAMPED, the level damping of the horizontal velocity by the log.
     void damp_interval();
@@ -342,6 +361,10 @@ class Firmware {
     /// nav_mode DAMPED: the reference point's ground velocity (E, N) [m/s]
     /// by the last reference used of each kind (the log's is v_log b + c)
     double damp_ref_[kRefKinds][2];
+    // The bumpless return (kBlendWindowS; blend_tick, solution).
+    double out_off_[4];           ///< added to the output: lat, lon [rad], v_E, v_N [m/s]
+    int32_t blend_window_;        ///< ticks left in which corrections go into out_off_
+    int32_t blend_on_;            ///< 1: out_off_ is not zero
 };
 
 }  // namespace pyins::firmware

@@ -72,6 +72,11 @@ void Firmware::start_nav_filter() {
     prm.sigma0_accel = cfg_.fine_sigma0_accel;
     nav_filter::init(nav_, prm, attitude::quat_to_mat(sd_.nav.quat_np));
     nav_on_ = 1;
+    for (int i = 0; i < 4; ++i) {
+        out_off_[i] = 0.0;
+    }
+    blend_window_ = 0;
+    blend_on_ = 0;
 }
 
 nav_filter::Motion Firmware::nav_motion() const {
@@ -93,6 +98,47 @@ void Firmware::nav_tick(const Vec3& dv_sf_n) {
             faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_KF_NOT_PD);
         }
         damp_interval();
+    }
+}
+
+void Firmware::blend_offset_m(double* east, double* north) const {
+    const nav_filter::Motion m = nav_motion();
+    *east = out_off_[1] * m.rn_h * m.cos_lat;
+    *north = out_off_[0] * m.rm_h;
+}
+
+void Firmware::blend_tick() {
+    if (blend_window_ > 0) {
+        blend_window_ = blend_window_ - 1;
+    }
+    if (blend_on_ == 0) {
+        return;
+    }
+    // exponential decay over kBlendTau, the step capped at kBlendSpeed
+    // (position) and kBlendAccel (velocity) times the tick
+    const double a = dt_ / kBlendTau;
+    double de;
+    double dn;
+    blend_offset_m(&de, &dn);
+    const double d = pmath::sqrt(de * de + dn * dn);
+    double sp = a;
+    if (d * sp > kBlendSpeed * dt_) {
+        sp = kBlendSpeed * dt_ / d;
+    }
+    const double v = pmath::sqrt(out_off_[2] * out_off_[2] + out_off_[3] * out_off_[3]);
+    double sv = a;
+    if (v * sv > kBlendAccel * dt_) {
+        sv = kBlendAccel * dt_ / v;
+    }
+    out_off_[0] = out_off_[0] * (1.0 - sp);
+    out_off_[1] = out_off_[1] * (1.0 - sp);
+    out_off_[2] = out_off_[2] * (1.0 - sv);
+    out_off_[3] = out_off_[3] * (1.0 - sv);
+    if (d < kBlendDoneM && v < kBlendDoneMps) {
+        for (int i = 0; i < 4; ++i) {
+            out_off_[i] = 0.0;
+        }
+        blend_on_ = 0;
     }
 }
 
@@ -484,6 +530,10 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         reject_ref(slot);
         return;
     }
+    // a correction after a spell without one: blended into the output
+    if (nav_mode_now() != PYINS_NAV_INTEGRATED) {
+        blend_window_ = kBlendWindowS * cfg_.tick_hz;
+    }
     use_ref(slot);
     if (cfg_.nav_mode == PYINS_NAV_DAMPED) {
         // a damping reference, not a filter measurement: the reference
@@ -506,6 +556,14 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     nav.vel_n(1) = nav.vel_n(1) - x[nav_filter::kVel + 1];
     nav.lat = nav.lat - x[nav_filter::kPos + 1] / m.rm_h;
     nav.lon = wrap_pi(nav.lon - x[nav_filter::kPos] / (m.rn_h * m.cos_lat));
+    if (blend_window_ > 0) {
+        // the output stays where it was: the correction goes into its offset
+        out_off_[0] = out_off_[0] + x[nav_filter::kPos + 1] / m.rm_h;
+        out_off_[1] = out_off_[1] + x[nav_filter::kPos] / (m.rn_h * m.cos_lat);
+        out_off_[2] = out_off_[2] + x[nav_filter::kVel];
+        out_off_[3] = out_off_[3] + x[nav_filter::kVel + 1];
+        blend_on_ = 1;
+    }
     nav_filter::reset_feedback(nav_);
     nav_.c_start = attitude::quat_to_mat(nav.quat_np);
 }

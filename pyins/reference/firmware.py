@@ -581,6 +581,7 @@ class Firmware(NavAtSea):
                 dv_sf_n = strapdown.update(self.sd, dtheta_p - self.nav.gyro_bias * self.dt,
                                            dv_p - self.nav.accel_bias * self.dt, self.dt)
                 self.nav_tick(dv_sf_n)
+                self.blend_tick()
             else:
                 strapdown.update(self.sd, dtheta_p, dv_p, self.dt)
             if self.index_prm.n_steps > 0:
@@ -602,6 +603,12 @@ class Firmware(NavAtSea):
             lat, lon, height, vel = self.reference_point()
             if self.sd.vertical == strapdown.VERTICAL_HOLD:
                 vel[2] = 0.0
+        if self.blend_on and self.mode == abi.PYINS_MODE_NAVIGATE:
+            # the bumpless return: the output offset (mirrors solution)
+            lat = lat + self.out_off[0]
+            lon = wrap_pi(lon + self.out_off[1])
+            vel[0] = vel[0] + self.out_off[2]
+            vel[1] = vel[1] + self.out_off[3]
         q_np = nav.quat_np
         valid = self.att_valid
         if self.mode == abi.PYINS_MODE_COARSE_ALIGN and self.coarse.solved:

@@ -20,6 +20,12 @@ TURN_TAU = 20.0                         #: kTurnTau [s]
 STRAIGHT_RATE = 0.3 * math.pi / 180.0   #: kStraightRate [rad/s]
 STRAIGHT_S = 10                         #: kStraightS
 CURRENT_READINGS = 60                   #: kCurrentReadings
+BLEND_WINDOW_S = 10                     #: kBlendWindowS
+BLEND_TAU = 60.0                        #: kBlendTau [s]
+BLEND_SPEED = 0.5                       #: kBlendSpeed [m/s]
+BLEND_ACCEL = 0.002                     #: kBlendAccel [m/s^2]
+BLEND_DONE_M = 1e-3                     #: kBlendDoneM
+BLEND_DONE_MPS = 1e-5                   #: kBlendDoneMps
 LOG_MIN_HORIZONTAL = 0.5                #: kLogMinHorizontal
 U32 = 0xFFFFFFFF
 
@@ -61,6 +67,10 @@ class NavAtSea:
         self.bow_known = 0
         self.damp_on = 0
         self.damp_ref = [(0.0, 0.0)] * REF_KINDS
+        # the bumpless return (blend_tick, solution)
+        self.out_off = [0.0, 0.0, 0.0, 0.0]
+        self.blend_window = 0
+        self.blend_on = 0
 
     def start_nav_filter(self):
         cfg = self.cfg
@@ -92,6 +102,9 @@ class NavAtSea:
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
         self.nav = nav_filter.init(prm, attitude.quat_to_mat(self.sd.nav.quat_np))
         self.nav_on = 1
+        self.out_off = [0.0, 0.0, 0.0, 0.0]
+        self.blend_window = 0
+        self.blend_on = 0
 
     def nav_motion(self):
         nav = self.sd.nav
@@ -107,6 +120,33 @@ class NavAtSea:
             if self.nav.healthy == 0:
                 self.faults = self.faults | abi.PYINS_FAULT_KF_NOT_PD
             self.damp_interval()
+
+    def blend_offset_m(self):
+        """The output offset's position part in metres, (E, N) (mirrors blend_offset_m)."""
+        m = self.nav_motion()
+        return self.out_off[1] * m.rn_h * m.cos_lat, self.out_off[0] * m.rm_h
+
+    def blend_tick(self):
+        """The output offset's decay, once a tick in NAVIGATE (mirrors blend_tick)."""
+        if self.blend_window > 0:
+            self.blend_window -= 1
+        if not self.blend_on:
+            return
+        a = self.dt / BLEND_TAU
+        de, dn = self.blend_offset_m()
+        d = math.sqrt(de * de + dn * dn)
+        sp = a
+        if d * sp > BLEND_SPEED * self.dt:
+            sp = BLEND_SPEED * self.dt / d
+        o = self.out_off
+        v = math.sqrt(o[2] * o[2] + o[3] * o[3])
+        sv = a
+        if v * sv > BLEND_ACCEL * self.dt:
+            sv = BLEND_ACCEL * self.dt / v
+        self.out_off = [o[0] * (1.0 - sp), o[1] * (1.0 - sp), o[2] * (1.0 - sv), o[3] * (1.0 - sv)]
+        if d < BLEND_DONE_M and v < BLEND_DONE_MPS:
+            self.out_off = [0.0, 0.0, 0.0, 0.0]
+            self.blend_on = 0
 
     def reject_ref(self, slot):
         """A reference failed its gate (mirrors reject_ref)."""
@@ -348,6 +388,9 @@ class NavAtSea:
         if stale or not nis <= self.cfg["nav_gate"]:
             self.reject_ref(slot)
             return
+        # a correction after a spell without one: blended into the output (mirrors apply_ref)
+        if self.nav_mode_now() != abi.PYINS_NAV_INTEGRATED:
+            self.blend_window = BLEND_WINDOW_S * self.cfg["tick_hz"]
         self.use_ref(slot)
         if self.cfg["nav_mode"] == abi.PYINS_NAV_DAMPED:
             # a damping reference: the reference point's ground velocity it stands for
@@ -363,6 +406,12 @@ class NavAtSea:
         nav.vel_n[1] = nav.vel_n[1] - x[nav_filter.VEL + 1]
         nav.lat = nav.lat - x[nav_filter.POS + 1] / m.rm_h
         nav.lon = wrap_pi(nav.lon - x[nav_filter.POS] / (m.rn_h * m.cos_lat))
+        if self.blend_window > 0:
+            # the output stays where it was: the correction goes into its offset
+            o = self.out_off
+            self.out_off = [o[0] + x[nav_filter.POS + 1] / m.rm_h, o[1] + x[nav_filter.POS] / (m.rn_h * m.cos_lat),
+                            o[2] + x[nav_filter.VEL], o[3] + x[nav_filter.VEL + 1]]
+            self.blend_on = 1
         nav_filter.reset_feedback(self.nav)
         self.nav.c_start = attitude.quat_to_mat(nav.quat_np)
 
@@ -405,6 +454,11 @@ class NavAtSea:
         """The record's navigation-at-sea fields (mirrors the end of output())."""
         on = self.nav_on != 0
         p = self.nav.p if on else None
+        # the output's sigma takes in the output offset's distance (mirrors output())
+        off2 = 0.0
+        if self.blend_on:
+            de, dn = self.blend_offset_m()
+            off2 = de * de + dn * dn
         return {
             "nav_mode": self.nav_mode_now(),
             "ref_in_use": self.refs_in_use() if self.mode == abi.PYINS_MODE_NAVIGATE else 0,
@@ -414,7 +468,7 @@ class NavAtSea:
             "n_ref_stale": np.array(self.n_ref_stale),
             "nav_nis": np.array(self.nav_nis),
             "nav_sigma_pos_m": math.sqrt(p[nav_filter.POS, nav_filter.POS]
-                                         + p[nav_filter.POS + 1, nav_filter.POS + 1]) if on else 0.0,
+                                         + p[nav_filter.POS + 1, nav_filter.POS + 1] + off2) if on else 0.0,
             "nav_sigma_heading_rad": math.sqrt(p[nav_filter.PHI + 2, nav_filter.PHI + 2]) if on else 0.0,
             "nav_gyro_bias_rad_s": self.nav.gyro_bias.copy() if on else np.zeros(3),
             "nav_accel_bias_mps2": self.nav.accel_bias.copy() if on else np.zeros(3),
