@@ -65,14 +65,21 @@ inline constexpr int32_t kCurrentReadings = 60;
 /// while that axis's horizontal part (cos pitch) is above this (pitch under
 /// 60 deg; a ship never pitches so: a log or an attitude that is wrong).
 inline constexpr double kLogMinHorizontal = 0.5;
-/// Bumpless return to INTEGRATED (docs/concepts.md, "At sea"): for
-/// kBlendWindowS after a correction that follows a spell without one (an
-/// outage, DAMPED or UNDAMPED, the start of NAVIGATE), the filter's
-/// corrections move the navigation solution as always but are added to an
-/// output offset, so that the output does not jump; the offset then decays
+/// Bumpless return to INTEGRATED (docs/concepts.md, "At sea"): a
+/// correction of more than kBlendMinM of position or kBlendMinMps of
+/// velocity (what an outage drifted, not a fix's noise: the first fixes
+/// after an outage, DAMPED or UNDAMPED take most of it) opens a window of
+/// kBlendWindowS in which the filter's corrections move the navigation
+/// solution as always but are added to an output offset, so that the
+/// output does not jump; the offset then decays
 /// with the time constant kBlendTau, its position part by at most
 /// kBlendSpeed and its velocity part by at most kBlendAccel (the at-sea
 /// bound for a switch: under 1 m and 1 cm/s from one second to the next).
+/// Corrections at the fixes' noise are applied to the output at once, as
+/// blending them would keep their noise in it after the filter has
+/// averaged it out.
+inline constexpr double kBlendMinM = 10.0;
+inline constexpr double kBlendMinMps = 0.1;
 inline constexpr int32_t kBlendWindowS = 10;
 inline constexpr double kBlendTau = 60.0;      ///< [s]
 inline constexpr double kBlendSpeed = 0.5;     ///< [m/s]

@@ -530,10 +530,6 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         reject_ref(slot);
         return;
     }
-    // a correction after a spell without one: blended into the output
-    if (nav_mode_now() != PYINS_NAV_INTEGRATED) {
-        blend_window_ = kBlendWindowS * cfg_.tick_hz;
-    }
     use_ref(slot);
     if (cfg_.nav_mode == PYINS_NAV_DAMPED) {
         // a damping reference, not a filter measurement: the reference
@@ -556,6 +552,14 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
     nav.vel_n(1) = nav.vel_n(1) - x[nav_filter::kVel + 1];
     nav.lat = nav.lat - x[nav_filter::kPos + 1] / m.rm_h;
     nav.lon = wrap_pi(nav.lon - x[nav_filter::kPos] / (m.rn_h * m.cos_lat));
+    // a correction that would be a jump opens the window (kBlendMinM)
+    const double dp = pmath::sqrt(x[nav_filter::kPos] * x[nav_filter::kPos] +
+                                  x[nav_filter::kPos + 1] * x[nav_filter::kPos + 1]);
+    const double dv = pmath::sqrt(x[nav_filter::kVel] * x[nav_filter::kVel] +
+                                  x[nav_filter::kVel + 1] * x[nav_filter::kVel + 1]);
+    if (dp > kBlendMinM || dv > kBlendMinMps) {
+        blend_window_ = kBlendWindowS * cfg_.tick_hz;
+    }
     if (blend_window_ > 0) {
         // the output stays where it was: the correction goes into its offset
         out_off_[0] = out_off_[0] + x[nav_filter::kPos + 1] / m.rm_h;

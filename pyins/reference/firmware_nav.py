@@ -20,6 +20,8 @@ TURN_TAU = 20.0                         #: kTurnTau [s]
 STRAIGHT_RATE = 0.3 * math.pi / 180.0   #: kStraightRate [rad/s]
 STRAIGHT_S = 10                         #: kStraightS
 CURRENT_READINGS = 60                   #: kCurrentReadings
+BLEND_MIN_M = 10.0                      #: kBlendMinM
+BLEND_MIN_MPS = 0.1                     #: kBlendMinMps
 BLEND_WINDOW_S = 10                     #: kBlendWindowS
 BLEND_TAU = 60.0                        #: kBlendTau [s]
 BLEND_SPEED = 0.5                       #: kBlendSpeed [m/s]
@@ -388,9 +390,6 @@ class NavAtSea:
         if stale or not nis <= self.cfg["nav_gate"]:
             self.reject_ref(slot)
             return
-        # a correction after a spell without one: blended into the output (mirrors apply_ref)
-        if self.nav_mode_now() != abi.PYINS_NAV_INTEGRATED:
-            self.blend_window = BLEND_WINDOW_S * self.cfg["tick_hz"]
         self.use_ref(slot)
         if self.cfg["nav_mode"] == abi.PYINS_NAV_DAMPED:
             # a damping reference: the reference point's ground velocity it stands for
@@ -406,6 +405,11 @@ class NavAtSea:
         nav.vel_n[1] = nav.vel_n[1] - x[nav_filter.VEL + 1]
         nav.lat = nav.lat - x[nav_filter.POS + 1] / m.rm_h
         nav.lon = wrap_pi(nav.lon - x[nav_filter.POS] / (m.rn_h * m.cos_lat))
+        # a correction that would be a jump opens the window (mirrors apply_ref)
+        dp = math.sqrt(x[nav_filter.POS] * x[nav_filter.POS] + x[nav_filter.POS + 1] * x[nav_filter.POS + 1])
+        dv = math.sqrt(x[nav_filter.VEL] * x[nav_filter.VEL] + x[nav_filter.VEL + 1] * x[nav_filter.VEL + 1])
+        if dp > BLEND_MIN_M or dv > BLEND_MIN_MPS:
+            self.blend_window = BLEND_WINDOW_S * self.cfg["tick_hz"]
         if self.blend_window > 0:
             # the output stays where it was: the correction goes into its offset
             o = self.out_off

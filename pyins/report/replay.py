@@ -223,7 +223,7 @@ def plot_references(nav, hz, kinds, gate, path):
     fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     slots = {name: abi_kind - 1 for name, abi_kind in kinds.items()}
     rows = [("integrated", (nav["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float)),
-            ("damped (log)", (nav["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
+            ("damped", (nav["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
     rows += [(f"{name} in use", ((nav["ref_in_use"] >> s) & 1).astype(float))
              for name, s in sorted(slots.items(), key=lambda kv: kv[1])]
     for j, (label, on) in enumerate(rows):      # one lane each: up while on

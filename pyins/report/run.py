@@ -294,7 +294,7 @@ def plot_references(summary, series, path):
         ax[1, j].axhline(gate, color="r", lw=0.8, ls="--", label=f"gate {gate:.4g}")
         ax[1, j].set_ylabel("normalised innovation (last)")
         lanes = [("integrated", (o["nav_mode"] == abi.PYINS_NAV_INTEGRATED).astype(float)),
-                 ("damped (log)", (o["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
+                 ("damped", (o["nav_mode"] == abi.PYINS_NAV_DAMPED).astype(float))]
         lanes += [(f"{names[k]} in use", ((o["ref_in_use"] >> k) & 1).astype(float)) for k in kinds]
         for i, (name, on) in enumerate(lanes):
             ax[2, j].step(t, on * 0.6 + i, where="post", lw=1.0, color="k" if i < 2 else f"C{i - 2}")

@@ -149,12 +149,7 @@ def test_the_analysis_is_the_filter_the_firmware_runs(firmware):
         o = res["outputs"]
         k = o["tick"] // 100                # the record of tick T carries P before tick T's fix
         heading = o["nav_sigma_heading_rad"] / cov.sigma_pred[k, 2] - 1.0
-        # the position sigma of a record takes in the output's offset while
-        # the first fixes' corrections are blended (the bumpless return,
-        # docs/concepts.md; metres at most, gone within ~10 min): compared
-        # after 15 min
-        late = o["tick"] >= 900 * 100
-        pos = o["nav_sigma_pos_m"][late] / np.hypot(cov.sigma_pred[k[late], 5], cov.sigma_pred[k[late], 6]) - 1.0
+        pos = o["nav_sigma_pos_m"] / np.hypot(cov.sigma_pred[k, 5], cov.sigma_pred[k, 6]) - 1.0
         # the firmware linearises at its own estimate (arcminutes, cm/s off
         # the truth) with its measured specific force; measured within
         # 0.25 % (heading) and 0.03 % (position). 1 % and 0.2 %: the
