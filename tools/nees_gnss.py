@@ -4,7 +4,7 @@ estimation error squared (NEES) over many runs of a voyage with GNSS,
 against the chi-square 95 % bounds (the at-sea issue's acceptance 2).
 
     .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002]
-                                        [--bias 0] [--indexing]
+                                        [--prior default|seed002] [--bias 0] [--indexing]
 
 Each run (seed s = 0 .. seeds - 1) navigates `pyins.sim.default_voyage`
 (route seed 1; the general sea state; the IMU fixed unless --indexing, then
@@ -17,6 +17,11 @@ from its prior: gyro biases 0.01 deg/h, accelerometer biases 100 ug, white
 noise at the densities it assumes (0.001 deg/sqrt(h), 10 ug/sqrt(Hz)).
 ``--errors seed002``: seed 002's error set instead (scale factors and
 installation errors the filter does not model), noise seeded per run.
+``--prior seed002``: the filter told seed 002's grade (fine_sigma0_gyro
+0.003 deg/h, fine_sigma0_accel 30 ug: its bias magnitudes; fine_gyro_arw
+0.0005 deg/sqrt(h), fine_accel_vrw 5 ug/sqrt(Hz): its noise) instead of
+the defaults (0.01 deg/h, 100 ug, 0.001 deg/sqrt(h), 10 ug/sqrt(Hz)); with
+``--errors model`` the biases and the noise are then drawn from that.
 GNSS at 1 Hz: 3 m (5 m up) white, 0.05 m/s; ``--bias`` the receiver's
 Gauss-Markov bias [m] (300 s), which the filter does not model (0: none).
 
@@ -47,14 +52,19 @@ GYRO_BIAS, ACCEL_BIAS = 0.01 * DEG_TO_RAD / 3600.0, 100e-6 * G0       # fine_sig
 GYRO_ARW, ACCEL_VRW = 0.001 * DEG_TO_RAD / 60.0, 10e-6 * G0           # fine_gyro_arw, fine_accel_vrw
 
 
-def one_run(motion, n, seed, errors, bias, indexing):
+PRIORS = {"default": (GYRO_BIAS, ACCEL_BIAS, GYRO_ARW, ACCEL_VRW),
+          "seed002": (0.003 * DEG_TO_RAD / 3600.0, 30e-6 * G0, 0.0005 * DEG_TO_RAD / 60.0, 5e-6 * G0)}
+
+
+def one_run(motion, n, seed, errors, bias, indexing, prior="default"):
+    gyro_prior, accel_prior, arw, vrw = PRIORS[prior]
     rng = np.random.default_rng(1000 + seed)
     if errors == "model":
         z3 = np.zeros(3)
-        sens = sim.SensorErrors(gyro_bias=rng.normal(0.0, GYRO_BIAS, 3), gyro_scale=z3,
-                                gyro_misalignment=np.zeros((3, 3)), gyro_arw=GYRO_ARW, gyro_quantum=0.0,
-                                accel_bias=rng.normal(0.0, ACCEL_BIAS, 3), accel_scale=z3,
-                                accel_misalignment=np.zeros((3, 3)), accel_vrw=ACCEL_VRW, accel_quantum=0.0)
+        sens = sim.SensorErrors(gyro_bias=rng.normal(0.0, gyro_prior, 3), gyro_scale=z3,
+                                gyro_misalignment=np.zeros((3, 3)), gyro_arw=arw, gyro_quantum=0.0,
+                                accel_bias=rng.normal(0.0, accel_prior, 3), accel_scale=z3,
+                                accel_misalignment=np.zeros((3, 3)), accel_vrw=vrw, accel_quantum=0.0)
     else:
         sens = sim.preset("seed002")
     phi = rng.normal(0.0, 1.0, 3) * SIGMA0_ATT
@@ -62,6 +72,9 @@ def one_run(motion, n, seed, errors, bias, indexing):
     dp = rng.normal(0.0, SIGMA0_POS, 2)
     cfg = dict(initial_errors(motion, phi=phi, velocity=[dv[0], dv[1], 0.0], north=dp[1], east=dp[0]),
                fine_sigma0_att_rad=SIGMA0_ATT)
+    if prior != "default":
+        cfg.update(fine_sigma0_gyro=gyro_prior, fine_sigma0_accel=accel_prior, fine_gyro_arw=arw,
+                   fine_accel_vrw=vrw)
     g = references.gnss(motion, n * DT, seed=2000 + seed, bias_sigma_m=bias)
     refs = g.refs.astype(contract.REF_DTYPE)
     if indexing:
@@ -82,6 +95,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=30)
     ap.add_argument("--hours", type=float, default=2.0)
     ap.add_argument("--errors", choices=("model", "seed002"), default="model")
+    ap.add_argument("--prior", choices=tuple(PRIORS), default="default",
+                    help="the bias sigmas the filter is told (seed002: its grade)")
     ap.add_argument("--bias", type=float, default=0.0, help="GNSS Gauss-Markov bias sigma [m]")
     ap.add_argument("--indexing", action="store_true", help="two-position indexing (closed loop)")
     args = ap.parse_args()
@@ -90,7 +105,7 @@ def main():
     t0 = time.perf_counter()
     heads, hors = [], []
     for s in range(args.seeds):
-        t, h, p = one_run(motion, n, s, args.errors, args.bias, args.indexing)
+        t, h, p = one_run(motion, n, s, args.errors, args.bias, args.indexing, args.prior)
         heads.append(h)
         hors.append(p)
         print(f"  run {s + 1}/{args.seeds}: mean NEES heading {h[t >= 600].mean():.2f}, horizontal "
@@ -100,7 +115,8 @@ def main():
     b1 = (chi2.ppf(0.025, N) / N, chi2.ppf(0.975, N) / N)
     b2 = (chi2.ppf(0.025, 2 * N) / (2 * N), chi2.ppf(0.975, 2 * N) / (2 * N))
     late = t >= 600.0
-    print(f"\nvoyage {args.hours:g} h, {N} runs, errors {args.errors}, GNSS bias {args.bias:g} m, "
+    print(f"\nvoyage {args.hours:g} h, {N} runs, errors {args.errors}, prior {args.prior}, "
+          f"GNSS bias {args.bias:g} m, "
           f"{'two-position indexing' if args.indexing else 'IMU fixed'}")
     for name, v, (lo, hi) in (("heading", head, b1), ("horizontal", hor, b2)):
         inside = np.mean((v[late] >= lo) & (v[late] <= hi))
