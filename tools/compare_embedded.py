@@ -189,6 +189,9 @@ def first_difference(a, b):
     return None
 
 
+SOFTFP_CASES = 60000     # csrc/embedded/softfp_check.c's cases
+
+
 def softfp_wrong(lines):
     """The cases of csrc/embedded/softfp_check.c ("op a b result" in hex)
     whose result is not the host's IEEE 754 double (correctly rounded):
@@ -224,8 +227,21 @@ def main(argv=None):
     for name, elf, board in (("cortex-m7", args.m7, "mps2-an500"), ("cortex-m4f", args.m4, "mps2-an386")):
         check = os.path.join(os.path.dirname(elf), "softfp_check.elf")
         if os.path.exists(check):
-            lines, rc = run_lines(["qemu-system-arm", "-M", board, "-nographic", "-semihosting", "-kernel", check])
+            cmd = ["qemu-system-arm", "-M", board, "-nographic", "-semihosting", "-kernel", check]
+            lines, rc = run_lines(cmd)
             n, wrong = softfp_wrong(lines)
+            if n != SOFTFP_CASES and not wrong and rc == 0:
+                # seen once under a heavy load: 59,974 of the 60,000 lines read whole,
+                # none wrong. The output's transport, not the arithmetic: kept for a
+                # look, said, and read again once (a wrong sum is never retried)
+                short = os.path.join(os.path.dirname(os.path.abspath(args.json)), f"softfp_{name}_short.txt")
+                os.makedirs(os.path.dirname(short), exist_ok=True)
+                with open(short, "w") as f:
+                    f.write("\n".join(lines) + "\n")
+                print(f"{name:11s} read {n} of {SOFTFP_CASES} soft-double cases whole (output kept in {short}): "
+                      "running the check again")
+                lines, rc = run_lines(cmd)
+                n, wrong = softfp_wrong(lines)
             softfp[name] = (n, wrong, rc)
     ref_name = "host" if "host" in runs else "python"
     ref = runs[ref_name][0]
@@ -238,7 +254,7 @@ def main(argv=None):
         result[f"{name}_identical"] = same
         print(f"{name:11s} {'bit-identical to ' + ref_name if same else 'DIFFERS: ' + str(diff or f'exit {rc}')}")
     for name, (n, wrong, rc) in softfp.items():
-        good = not wrong and rc == 0 and n == 60000
+        good = not wrong and rc == 0 and n == SOFTFP_CASES
         ok = ok and good
         result[f"{name}_softfp_wrong"] = len(wrong)
         print(f"{name:11s} {n} double sums and differences: "
