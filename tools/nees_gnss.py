@@ -5,6 +5,7 @@ against the chi-square 95 % bounds (the at-sea issue's acceptance 2).
 
     .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002]
                                         [--prior default|seed002] [--bias 0] [--indexing]
+                                        [--workers 1]
 
 Each run (seed s = 0 .. seeds - 1) navigates `pyins.sim.default_voyage`
 (route seed 1; the general sea state; the IMU fixed unless --indexing, then
@@ -35,6 +36,7 @@ chi-square(2N) / (2N). Printed: the share of record times after the first
 its bounds, at a few times.
 """
 import argparse
+import concurrent.futures
 import time
 
 import numpy as np
@@ -90,6 +92,32 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default"):
     return e.time_s, head, hor
 
 
+_MOTIONS = {}
+
+
+def _run_seed(a):
+    """One seed, in this process or a worker; the voyage built once per
+    process (deterministic: route seed 1), not sent to the workers."""
+    hours, n, s, (errors, bias, indexing, prior) = a
+    if hours not in _MOTIONS:
+        _MOTIONS[hours] = sim.default_voyage(hours, seed=1)
+    return one_run(_MOTIONS[hours], n, s, errors, bias, indexing, prior)
+
+
+class _Inline:
+    """One process: map in order, as the pool does."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    @staticmethod
+    def map(fn, items):
+        return map(fn, items)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
@@ -99,17 +127,22 @@ def main():
                     help="the bias sigmas the filter is told (seed002: its grade)")
     ap.add_argument("--bias", type=float, default=0.0, help="GNSS Gauss-Markov bias sigma [m]")
     ap.add_argument("--indexing", action="store_true", help="two-position indexing (closed loop)")
+    ap.add_argument("--workers", type=int, default=1, help="runs at once (processes); the figures do not "
+                                                           "depend on it")
     args = ap.parse_args()
-    motion = sim.default_voyage(args.hours, seed=1)
+    if args.workers < 1:
+        ap.error("--workers: at least 1")
     n = int(round(args.hours * 3600.0 / DT))
     t0 = time.perf_counter()
     heads, hors = [], []
-    for s in range(args.seeds):
-        t, h, p = one_run(motion, n, s, args.errors, args.bias, args.indexing, args.prior)
-        heads.append(h)
-        hors.append(p)
-        print(f"  run {s + 1}/{args.seeds}: mean NEES heading {h[t >= 600].mean():.2f}, horizontal "
-              f"{p[t >= 600].mean():.2f} ({time.perf_counter() - t0:.0f} s)", flush=True)
+    job = (args.errors, args.bias, args.indexing, args.prior)
+    with concurrent.futures.ProcessPoolExecutor(args.workers) if args.workers > 1 else _Inline() as pool:
+        runs = pool.map(_run_seed, [(args.hours, n, s, job) for s in range(args.seeds)])
+        for s, (t, h, p) in enumerate(runs):
+            heads.append(h)
+            hors.append(p)
+            print(f"  run {s + 1}/{args.seeds}: mean NEES heading {h[t >= 600].mean():.2f}, horizontal "
+                  f"{p[t >= 600].mean():.2f} ({time.perf_counter() - t0:.0f} s)", flush=True)
     head, hor = np.mean(heads, axis=0), np.mean(hors, axis=0)
     N = args.seeds
     b1 = (chi2.ppf(0.025, N) / N, chi2.ppf(0.975, N) / N)
