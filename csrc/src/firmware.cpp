@@ -113,6 +113,8 @@ void Firmware::init(const pyins_config& raw) {
     for (int i = 0; i < 4; ++i) {
         out_off_[i] = 0.0;
     }
+    blend_m_rad_[0] = 0.0;
+    blend_m_rad_[1] = 0.0;
     blend_window_ = 0;
     blend_on_ = 0;
     // a wander of 90 deg or more reads 1 (coarse_align::rotation_sine)

@@ -259,7 +259,9 @@ class Firmware {
     void nav_tick(const Vec3& dv_sf_n);
     /// The output offset's decay, once a tick in NAVIGATE (kBlendTau).
     void blend_tick();
-    /// The output offset's position part in metres (E, N).
+    /// The output offset's position part in metres (E, N), by the Earth's
+    /// radii where it was taken (blend_m_rad_: over the minutes of a blend
+    /// they change by a part in 10^6; no radii computed a tick).
     void blend_offset_m(double* east, double* north) const;
     /// Once a filter interval in NAVIGATE: the course's turn rate and, in
     /// DAMPED, the level damping of the horizontal velocity by the log.
@@ -370,6 +372,7 @@ class Firmware {
     double damp_ref_[kRefKinds][2];
     // The bumpless return (kBlendWindowS; blend_tick, solution).
     double out_off_[4];           ///< added to the output: lat, lon [rad], v_E, v_N [m/s]
+    double blend_m_rad_[2];       ///< metres a radian of lon, lat where the offset was taken (E, N)
     int32_t blend_window_;        ///< ticks left in which corrections go into out_off_
     int32_t blend_on_;            ///< 1: out_off_ is not zero
 };

@@ -75,6 +75,8 @@ void Firmware::start_nav_filter() {
     for (int i = 0; i < 4; ++i) {
         out_off_[i] = 0.0;
     }
+    blend_m_rad_[0] = 0.0;
+    blend_m_rad_[1] = 0.0;
     blend_window_ = 0;
     blend_on_ = 0;
 }
@@ -102,9 +104,8 @@ void Firmware::nav_tick(const Vec3& dv_sf_n) {
 }
 
 void Firmware::blend_offset_m(double* east, double* north) const {
-    const nav_filter::Motion m = nav_motion();
-    *east = out_off_[1] * m.rn_h * m.cos_lat;
-    *north = out_off_[0] * m.rm_h;
+    *east = out_off_[1] * blend_m_rad_[0];
+    *north = out_off_[0] * blend_m_rad_[1];
 }
 
 void Firmware::blend_tick() {
@@ -566,6 +567,8 @@ void Firmware::apply_ref(const pyins_ref& ref, int64_t lag) {
         out_off_[1] = out_off_[1] + x[nav_filter::kPos] / (m.rn_h * m.cos_lat);
         out_off_[2] = out_off_[2] + x[nav_filter::kVel];
         out_off_[3] = out_off_[3] + x[nav_filter::kVel + 1];
+        blend_m_rad_[0] = m.rn_h * m.cos_lat;
+        blend_m_rad_[1] = m.rm_h;
         blend_on_ = 1;
     }
     nav_filter::reset_feedback(nav_);

@@ -71,6 +71,7 @@ class NavAtSea:
         self.damp_ref = [(0.0, 0.0)] * REF_KINDS
         # the bumpless return (blend_tick, solution)
         self.out_off = [0.0, 0.0, 0.0, 0.0]
+        self.blend_m_rad = (0.0, 0.0)
         self.blend_window = 0
         self.blend_on = 0
 
@@ -105,6 +106,7 @@ class NavAtSea:
         self.nav = nav_filter.init(prm, attitude.quat_to_mat(self.sd.nav.quat_np))
         self.nav_on = 1
         self.out_off = [0.0, 0.0, 0.0, 0.0]
+        self.blend_m_rad = (0.0, 0.0)
         self.blend_window = 0
         self.blend_on = 0
 
@@ -124,9 +126,9 @@ class NavAtSea:
             self.damp_interval()
 
     def blend_offset_m(self):
-        """The output offset's position part in metres, (E, N) (mirrors blend_offset_m)."""
-        m = self.nav_motion()
-        return self.out_off[1] * m.rn_h * m.cos_lat, self.out_off[0] * m.rm_h
+        """The output offset's position part in metres, (E, N), by the radii where
+        it was taken (mirrors blend_offset_m)."""
+        return self.out_off[1] * self.blend_m_rad[0], self.out_off[0] * self.blend_m_rad[1]
 
     def blend_tick(self):
         """The output offset's decay, once a tick in NAVIGATE (mirrors blend_tick)."""
@@ -415,6 +417,7 @@ class NavAtSea:
             o = self.out_off
             self.out_off = [o[0] + x[nav_filter.POS + 1] / m.rm_h, o[1] + x[nav_filter.POS] / (m.rn_h * m.cos_lat),
                             o[2] + x[nav_filter.VEL], o[3] + x[nav_filter.VEL + 1]]
+            self.blend_m_rad = (m.rn_h * m.cos_lat, m.rm_h)
             self.blend_on = 1
         nav_filter.reset_feedback(self.nav)
         self.nav.c_start = attitude.quat_to_mat(nav.quat_np)
