@@ -295,6 +295,16 @@ def _stages(spec):
         yield "static_fine"
 
 
+def record_steps(errors):
+    """How much the errors move from one record to the next: (velocity, the
+    larger of |d dv_E|, |d dv_N| [m/s]; position, |d (dE, dN)| [m]), one
+    value per pair of records. At a mode switch they are its jump (the
+    at-sea bound: under 1 cm/s and 1 m a second)."""
+    dv = np.abs(np.diff(errors.vel_n_mps[:, :2], axis=0)).max(axis=1)
+    dp = np.hypot(np.diff(errors.north_m), np.diff(errors.east_m))
+    return dv, dp
+
+
 def gnss_outages(refs, dt, end_s=None):
     """The GNSS outages of references ``refs`` (REF_DTYPE, or None): the gaps
     between position fixes longer than 2.5 times their usual interval (the

@@ -215,8 +215,7 @@ def main(argv=None):
     # 3. the switches
     mode = out["nav_mode"]
     sw = np.flatnonzero(np.diff(mode) != 0)
-    dv = np.abs(np.diff(ed.vel_n_mps[:, :2], axis=0)).max(axis=1)
-    dp = np.hypot(np.diff(ed.north_m), np.diff(ed.east_m))
+    dv, dp = metrics.record_steps(ed)
     steady = np.ones(len(dv), bool)
     steady[sw] = False
     fig["switches"] = {"count": int(len(sw)), "max_velocity_jump_mps": float(dv[sw].max()),

@@ -104,8 +104,7 @@ def test_every_switch_is_bumpless(runs):
     _, (e, o) = runs
     switch = np.flatnonzero(np.diff(o["nav_mode"]) != 0)
     assert len(switch) >= 6                   # in and out of every turn
-    dv = np.abs(np.diff(e.vel_n_mps[:, :2], axis=0)).max(axis=1)
-    dp = np.hypot(np.diff(e.north_m), np.diff(e.east_m))
+    dv, dp = metrics.record_steps(e)
     print(f"\n{len(switch)} switches: velocity error moves {dv[switch].max() * 1000:.2f} mm/s at most across "
           f"one, the position error {dp[switch].max():.2f} m")
     # the at-sea acceptance: < 1 cm/s and < 1 m across a switch (measured
