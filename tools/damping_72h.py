@@ -131,6 +131,10 @@ def main(argv=None):
     ap.add_argument("--out", default=os.path.join("docs", "results", "damping_72h"))
     ap.add_argument("--save", help="also write the time series to this .npz")
     args = ap.parse_args(argv)
+    if not args.hours >= 3.0:
+        # the spectrum needs two Schuler periods for its band, the analysis
+        # its 2 h transient and 1-h means after it
+        ap.error(f"--hours {args.hours:g}: at least 3 (the Schuler band of the spectrum, the 2 h transient)")
     base = scenario.load("voyage_log").with_overrides({"duration": f"{args.hours:g} h",
                                                         "indexing.scheme": args.scheme})
     spec = next(base.runs())
