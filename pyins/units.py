@@ -94,6 +94,8 @@ UNITS = {
     # a rate density [rad/s/sqrt(Hz)] is numerically the same as rad/sqrt(s).
     "angle_random_walk": {"rad/sqrt(s)": 1.0, "deg/sqrt(h)": DPSH_TO_RPSS,
                           "rad/s/sqrt(Hz)": 1.0, "deg/h/sqrt(Hz)": DPH_TO_RPS},
+    # a rate's random walk (a gyro bias's instability): 1 deg/h/sqrt(h) = DPH_TO_RPS / 60 rad/s/sqrt(s)
+    "rate_random_walk": {"rad/s/sqrt(s)": 1.0, "deg/h/sqrt(h)": DPH_TO_RPS / 60.0},
     "acceleration": {"m/s^2": 1.0, "g": _G0, "mg": 1e-3 * _G0, "ug": UG_TO_MPS2},
     # 1 ug/sqrt(Hz) = UG_TO_MPS2 (m/s^2)/sqrt(Hz), numerically the same in (m/s)/sqrt(s).
     "velocity_random_walk": {"m/s/sqrt(s)": 1.0, "m/s/sqrt(h)": 1.0 / 60.0,
@@ -112,6 +114,7 @@ DIMENSION_NAMES = {
     "angle": "an angle", "angular_rate": "an angular rate",
     "angular_acceleration": "an angular acceleration",
     "angle_random_walk": "an angle random walk", "acceleration": "an acceleration",
+    "rate_random_walk": "a rate random walk",
     "velocity_random_walk": "a velocity random walk", "velocity": "a velocity",
     "length": "a length", "time": "a time", "frequency": "a frequency",
     "dimensionless": "a dimensionless number",
@@ -225,6 +228,7 @@ def split_quantity(text):
 def _example(dimension):
     return {"angle": "10 arcsec", "angular_rate": "0.003 deg/h", "time": "72 h",
             "angle_random_walk": "0.0005 deg/sqrt(h)", "acceleration": "30 ug",
+            "rate_random_walk": "0.0005 deg/h/sqrt(h)",
             "velocity_random_walk": "5 ug/sqrt(Hz)", "length": "10 m", "velocity": "0.01 m/s",
             "angular_acceleration": "30 deg/s^2", "frequency": "0.2 Hz",
             "dimensionless": "10 ppm"}[dimension]

@@ -3,9 +3,9 @@
 estimation error squared (NEES) over many runs of a voyage with GNSS,
 against the chi-square 95 % bounds (the at-sea issue's acceptance 2).
 
-    .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002]
+    .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002|seed002-draws]
                                         [--prior default|seed002] [--bias 0] [--indexing]
-                                        [--workers 1]
+                                        [--table-model] [--bias-rw 0] [--workers 1]
 
 Each run (seed s = 0 .. seeds - 1) navigates `pyins.sim.default_voyage`
 (route seed 1; the general sea state; the IMU fixed unless --indexing, then
@@ -17,12 +17,23 @@ position 10 m per horizontal axis (the filter's kNavSigma0Vel and Pos).
 from its prior: gyro biases 0.01 deg/h, accelerometer biases 100 ug, white
 noise at the densities it assumes (0.001 deg/sqrt(h), 10 ug/sqrt(Hz)).
 ``--errors seed002``: seed 002's error set instead (scale factors and
-installation errors the filter does not model), noise seeded per run.
+installation errors the filter does not model), noise seeded per run:
+every run has the same +1-sigma errors (the papers' set as PSINS's
+imuerrset builds it), so the runs share one error and their mean NEES is
+not chi-square(N) / N: a test of that one unit, not of consistency.
+``--errors seed002-draws``: run s draws its random constants from seed
+002's 1-sigma values (`pyins.sim.sensors.draw_random_constants("seed002", s)`: bias,
+scale factor, installation terms, signs and sizes random), the test of
+consistency over a production of units.
 ``--prior seed002``: the filter told seed 002's grade (fine_sigma0_gyro
 0.003 deg/h, fine_sigma0_accel 30 ug: its bias magnitudes; fine_gyro_arw
 0.0005 deg/sqrt(h), fine_accel_vrw 5 ug/sqrt(Hz): its noise) instead of
 the defaults (0.01 deg/h, 100 ug, 0.001 deg/sqrt(h), 10 ug/sqrt(Hz)); with
 ``--errors model`` the biases and the noise are then drawn from that.
+``--table-model``: the filter told seed 002's gyro scale factor (10 ppm) and
+misalignment (10 arcsec) as nav_table_scale_sigma and nav_table_mis_sigma
+(the heading and tilt each table move exposes); ``--bias-rw`` its
+nav_gyro_bias_rw [deg/h/sqrt(h)] (0: the biases random constants).
 GNSS at 1 Hz: 3 m (5 m up) white, 0.05 m/s; ``--bias`` the receiver's
 Gauss-Markov bias [m] (300 s), which the filter does not model (0: none).
 
@@ -46,6 +57,7 @@ from pyins import contract, fil, metrics, sim
 from pyins.open_loop import navigate
 from pyins.scenario.build import initial_errors
 from pyins.sim import references
+from pyins.sim.sensors import draw_random_constants
 from pyins.units import ARCMIN_TO_RAD, DEG_TO_RAD, DT, G0
 
 SIGMA0_ATT = np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD     # configured: the filter's prior
@@ -54,11 +66,12 @@ GYRO_BIAS, ACCEL_BIAS = 0.01 * DEG_TO_RAD / 3600.0, 100e-6 * G0       # fine_sig
 GYRO_ARW, ACCEL_VRW = 0.001 * DEG_TO_RAD / 60.0, 10e-6 * G0           # fine_gyro_arw, fine_accel_vrw
 
 
+TABLE_SCALE, TABLE_MIS = 10e-6, 10.0 * ARCMIN_TO_RAD / 60.0     # seed 002's gyro scale factor, misalignment
 PRIORS = {"default": (GYRO_BIAS, ACCEL_BIAS, GYRO_ARW, ACCEL_VRW),
           "seed002": (0.003 * DEG_TO_RAD / 3600.0, 30e-6 * G0, 0.0005 * DEG_TO_RAD / 60.0, 5e-6 * G0)}
 
 
-def one_run(motion, n, seed, errors, bias, indexing, prior="default"):
+def one_run(motion, n, seed, errors, bias, indexing, prior="default", table_model=False, bias_rw=0.0):
     gyro_prior, accel_prior, arw, vrw = PRIORS[prior]
     rng = np.random.default_rng(1000 + seed)
     if errors == "model":
@@ -67,8 +80,10 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default"):
                                 gyro_misalignment=np.zeros((3, 3)), gyro_arw=arw, gyro_quantum=0.0,
                                 accel_bias=rng.normal(0.0, accel_prior, 3), accel_scale=z3,
                                 accel_misalignment=np.zeros((3, 3)), accel_vrw=vrw, accel_quantum=0.0)
-    else:
+    elif errors == "seed002":
         sens = sim.preset("seed002")
+    else:  # seed002-draws: run s's own production unit
+        sens = draw_random_constants("seed002", seed)
     phi = rng.normal(0.0, 1.0, 3) * SIGMA0_ATT
     dv = rng.normal(0.0, SIGMA0_VEL, 2)
     dp = rng.normal(0.0, SIGMA0_POS, 2)
@@ -77,6 +92,9 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default"):
     if prior != "default":
         cfg.update(fine_sigma0_gyro=gyro_prior, fine_sigma0_accel=accel_prior, fine_gyro_arw=arw,
                    fine_accel_vrw=vrw)
+    if table_model:
+        cfg.update(nav_table_scale_sigma=TABLE_SCALE, nav_table_mis_sigma=TABLE_MIS)
+    cfg.update(nav_gyro_bias_rw=bias_rw * DEG_TO_RAD / 3600.0 / 60.0)
     g = references.gnss(motion, n * DT, seed=2000 + seed, bias_sigma_m=bias)
     refs = g.refs.astype(contract.REF_DTYPE)
     if indexing:
@@ -98,10 +116,10 @@ _MOTIONS = {}
 def _run_seed(a):
     """One seed, in this process or a worker; the voyage built once per
     process (deterministic: route seed 1), not sent to the workers."""
-    hours, n, s, (errors, bias, indexing, prior) = a
+    hours, n, s, (errors, bias, indexing, prior, table_model, bias_rw) = a
     if hours not in _MOTIONS:
         _MOTIONS[hours] = sim.default_voyage(hours, seed=1)
-    return one_run(_MOTIONS[hours], n, s, errors, bias, indexing, prior)
+    return one_run(_MOTIONS[hours], n, s, errors, bias, indexing, prior, table_model, bias_rw)
 
 
 class _Inline:
@@ -122,11 +140,16 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
     ap.add_argument("--hours", type=float, default=2.0)
-    ap.add_argument("--errors", choices=("model", "seed002"), default="model")
+    ap.add_argument("--errors", choices=("model", "seed002", "seed002-draws"), default="model")
     ap.add_argument("--prior", choices=tuple(PRIORS), default="default",
                     help="the bias sigmas the filter is told (seed002: its grade)")
     ap.add_argument("--bias", type=float, default=0.0, help="GNSS Gauss-Markov bias sigma [m]")
     ap.add_argument("--indexing", action="store_true", help="two-position indexing (closed loop)")
+    ap.add_argument("--table-model", action="store_true",
+                    help="tell the filter seed 002's gyro scale factor and misalignment (10 ppm, 10 "
+                         "arcsec: nav_table_scale_sigma, nav_table_mis_sigma)")
+    ap.add_argument("--bias-rw", type=float, default=0.0,
+                    help="the filter's gyro bias random walk, nav_gyro_bias_rw [deg/h/sqrt(h)]")
     ap.add_argument("--workers", type=int, default=1, help="runs at once (processes); the figures do not "
                                                            "depend on it")
     args = ap.parse_args()
@@ -135,7 +158,7 @@ def main():
     n = int(round(args.hours * 3600.0 / DT))
     t0 = time.perf_counter()
     heads, hors = [], []
-    job = (args.errors, args.bias, args.indexing, args.prior)
+    job = (args.errors, args.bias, args.indexing, args.prior, args.table_model, args.bias_rw)
     with concurrent.futures.ProcessPoolExecutor(args.workers) if args.workers > 1 else _Inline() as pool:
         runs = pool.map(_run_seed, [(args.hours, n, s, job) for s in range(args.seeds)])
         for s, (t, h, p) in enumerate(runs):
@@ -150,7 +173,8 @@ def main():
     late = t >= 600.0
     print(f"\nvoyage {args.hours:g} h, {N} runs, errors {args.errors}, prior {args.prior}, "
           f"GNSS bias {args.bias:g} m, "
-          f"{'two-position indexing' if args.indexing else 'IMU fixed'}")
+          f"{'two-position indexing' if args.indexing else 'IMU fixed'}, table model "
+          f"{'on' if args.table_model else 'off'}, bias random walk {args.bias_rw:g} deg/h/sqrt(h)")
     for name, v, (lo, hi) in (("heading", head, b1), ("horizontal", hor, b2)):
         inside = np.mean((v[late] >= lo) & (v[late] <= hi))
         print(f"{name:10s} mean NEES over the runs: time average {v[late].mean():.3f} (bounds {lo:.3f} .. "

@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 17
+#define PYINS_ABI_VERSION_MINOR 18
 
 #ifdef __cplusplus
 extern "C" {
@@ -368,6 +368,15 @@ typedef struct pyins_config {
                                      antenna's position and velocity by its own attitude and rates;
                                      0 = fixes of the reference point; |r| <= 100 m (else
                                      PYINS_E_CONFIG_LEVER) */
+    /* The navigation filter's model of the IMU beyond its bias states (ABI 0.18; docs/concepts.md,
+     * "At sea", the filter's consistency). Each 0 = not modelled (0 is 0 here, not a default);
+     * finite, >= 0 and within the bound given (else PYINS_E_CONFIG_NAV). */
+    double nav_gyro_bias_rw;      /* the gyro biases' random walk, their instability [rad/s/sqrt(s)];
+                                     <= 1e-6 (0.2 deg/h/sqrt(s)) */
+    double nav_table_scale_sigma; /* sigma of the scale factor of the gyro on the table's axis [-]: a
+                                     heading error of that fraction of every table move; <= 0.01 */
+    double nav_table_mis_sigma;   /* sigma of the other two gyros' misalignment to the table's axis
+                                     [rad]: a tilt of at most that fraction of a move; <= 0.01 rad */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */

@@ -306,7 +306,7 @@ void pyins_t_nav_system_matrix(const double motion[6], const double f_n[3], cons
 }
 
 int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], const double* dv_sf_n,
-                           const double* motion, const double* c_np, const int32_t* kind,
+                           const double* dalpha, const double* motion, const double* c_np, const int32_t* kind,
                            const double* z, const double* r, size_t n, double* nis, double* x_out,
                            double* p_out, double* bias_out) {
     namespace nf = pyins::nav_filter;
@@ -324,13 +324,16 @@ int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], c
     prm.sigma0_pos = p->sigma0_pos;
     prm.sigma0_gyro = p->sigma0_gyro;
     prm.sigma0_accel = p->sigma0_accel;
+    prm.gyro_bias_rw = p->gyro_bias_rw;
+    prm.table_scale = p->table_scale;
+    prm.table_mis = p->table_mis;
     nf::NavFilter f;
     nf::init(f, prm, m9(c_np0));
     int updates = 0;
     for (size_t k = 0; k < n; ++k) {
         const nf::Motion mo = nav_motion6(motion + 6 * k);
         const Mat3 c = m9(c_np + 9 * k);
-        nf::gather(f, v3(dv_sf_n + 3 * k));
+        nf::gather(f, v3(dv_sf_n + 3 * k), dalpha[k]);
         if (f.ticks == f.prm.every) {
             nf::predict(f, mo, c);
         }

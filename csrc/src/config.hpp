@@ -91,6 +91,12 @@ inline constexpr double kDefaultNavGate = 13.8155;   ///< -2 ln(0.001)
 inline constexpr int32_t kDefaultNavRejectLimit = 10;
 inline constexpr int32_t kDefaultRefLatencyS = 1;
 inline constexpr int32_t kRefHorizonS = 10;
+/// Bounds on the navigation filter's model beyond its bias states
+/// (pyins_core.h): a random walk of 0.2 deg/h per sqrt(s), a scale factor
+/// or misalignment of 1 % (far beyond any gyro a ship's INS carries; the
+/// bound catches a value in the wrong unit).
+inline constexpr double kMaxNavGyroBiasRw = 1e-6;
+inline constexpr double kMaxNavTableSigma = 0.01;
 /// Initial sigmas of the navigation filter's position and velocity when
 /// navigation starts from an alignment at the site [m, m/s] (the site's
 /// survey; the alignment's velocity residual), and of its attitude when no

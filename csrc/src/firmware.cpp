@@ -790,7 +790,7 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
             // the biases the filter estimated, compensated (0 until it has)
             const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p - nav_.gyro_bias * dt_,
                                                    dv_p - nav_.accel_bias * dt_, dt_);
-            nav_tick(dv_sf_n);
+            nav_tick(dv_sf_n, dalpha);
             blend_tick();
         } else {
             strapdown::update(sd_, dtheta_p, dv_p, dt_);

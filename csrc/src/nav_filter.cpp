@@ -45,6 +45,8 @@ void init(NavFilter& f, const Params& prm, const Mat3& c_np) {
     f.dv_sum = Vec3::Zero();
     f.c_start = c_np;
     f.ticks = 0;
+    f.move_angle = 0.0;
+    f.move_q = 0.0;
     f.healthy = 1;
     f.gyro_bias = Vec3::Zero();
     f.accel_bias = Vec3::Zero();
@@ -129,6 +131,20 @@ void predict(NavFilter& f, const Motion& m, const Mat3& c_np) {
     f.p(kPhi + 2, kPhi + 2) = f.p(kPhi + 2, kPhi + 2) + q_att;
     f.p(kVel + 0, kVel + 0) = f.p(kVel + 0, kVel + 0) + q_vel;
     f.p(kVel + 1, kVel + 1) = f.p(kVel + 1, kVel + 1) + q_vel;
+    if (f.prm.gyro_bias_rw > 0.0) {
+        const double q_eps = f.prm.gyro_bias_rw * f.prm.gyro_bias_rw * span;
+        f.p(kEps + 0, kEps + 0) = f.p(kEps + 0, kEps + 0) + q_eps;
+        f.p(kEps + 1, kEps + 1) = f.p(kEps + 1, kEps + 1) + q_eps;
+        f.p(kEps + 2, kEps + 2) = f.p(kEps + 2, kEps + 2) + q_eps;
+    }
+    if (f.move_q > 0.0) {
+        const double q_tilt = f.prm.table_mis * f.prm.table_mis * f.move_q;
+        const double q_head = f.prm.table_scale * f.prm.table_scale * f.move_q;
+        f.p(kPhi + 0, kPhi + 0) = f.p(kPhi + 0, kPhi + 0) + q_tilt;
+        f.p(kPhi + 1, kPhi + 1) = f.p(kPhi + 1, kPhi + 1) + q_tilt;
+        f.p(kPhi + 2, kPhi + 2) = f.p(kPhi + 2, kPhi + 2) + q_head;
+    }
+    f.move_q = 0.0;
     symmetrise(f.p);
     f.dv_sum = Vec3::Zero();
     f.c_start = c_np;

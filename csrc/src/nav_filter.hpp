@@ -32,7 +32,17 @@
 // the trapezoid's error on the mean is 1e-3 of it).
 // Discretisation per interval T (nav_every_ticks, or up to a reference's
 // tick): Phi = I + F T + (F T)^2 / 2, Qd = diag(arw^2 T on phi, vrw^2 T on
-// dv), symmetrised, as moving_align.
+// dv, rw^2 T on eps), symmetrised, as moving_align.
+// The table's moves: the errors the filter does not carry as states that
+// a turn of the table by a exposes, the scale factor k_z of the gyro on
+// its axis (a heading error k_z a) and the misalignments m_xz, m_yz of the
+// other two to it (a tilt of at most m a, as the sensed rate turns with
+// the table), enter Qd as the growth of (sigma a)^2 over the interval:
+// sigma_k^2 d(a^2) on phi_U, sigma_m^2 d(a^2) on phi_E and phi_N (the
+// table's axis is the ship's vertical to within its roll and pitch). Each
+// move is taken as a fresh draw; on a ship the reverse move takes the
+// error back, so this is the conservative side (docs/concepts.md, "At
+// sea", the filter's consistency).
 //
 // Measurements (all unit rows: the vertical is held): a reference position
 // on [dp_E, dp_N], a reference or zero velocity on [dv_E, dv_N] (a DVL's
@@ -73,8 +83,11 @@ struct Params {
     double sigma0_pos;       ///< [m]
     double sigma0_gyro;      ///< [rad/s]
     double sigma0_accel;     ///< [m/s^2]
+    double gyro_bias_rw;     ///< the biases' random walk (their instability) [rad/s/sqrt(s)]; 0 = constants
+    double table_scale;      ///< sigma of the scale factor of the gyro on the table's axis [-]; 0 = none
+    double table_mis;        ///< sigma of the other gyros' misalignment to the table's axis [rad]; 0 = none
 };
-static_assert(sizeof(Params) == 11 * sizeof(double) + 2 * sizeof(int32_t), "nav_filter::Params has no padding");
+static_assert(sizeof(Params) == 14 * sizeof(double) + 2 * sizeof(int32_t), "nav_filter::Params has no padding");
 
 /// Where the ship is and how it moves: the linearisation point.
 struct Motion {
@@ -94,6 +107,8 @@ struct NavFilter {
     Mat3 c_start;            ///< C_p^n at the last time update
     int32_t ticks;           ///< ticks gathered since then
     int32_t healthy;         ///< 1 while P's diagonal stayed positive
+    double move_angle;       ///< the table's turn since it last stood still [rad]
+    double move_q;           ///< growth of move_angle^2 since the last time update [rad^2]
     Vec3 gyro_bias;          ///< compensated gyro biases, p [rad/s]
     Vec3 accel_bias;         ///< compensated accelerometer biases, p (z 0) [m/s^2]
 };
@@ -101,10 +116,21 @@ struct NavFilter {
 /// Start the filter at an attitude C_p^n (c_np): P diagonal from the sigmas.
 void init(NavFilter& f, const Params& prm, const Mat3& c_np);
 
-/// One tick's specific-force velocity increment in n' [m/s].
-inline void gather(NavFilter& f, const Vec3& dv_sf_n) {
+/// One tick's specific-force velocity increment in n' [m/s] and the
+/// table's turn over it dalpha [rad]: a move's angle a since the table last
+/// stood still, and the growth of a^2 (the variance a scale-factor error
+/// sigma_k gives the heading over a move is (sigma_k a)^2: the error is the
+/// same fraction of the whole move, not a random walk over its ticks).
+inline void gather(NavFilter& f, const Vec3& dv_sf_n, double dalpha) {
     f.dv_sum = f.dv_sum + dv_sf_n;
     f.ticks = f.ticks + 1;
+    if (dalpha != 0.0) {
+        // (a + da)^2 - a^2
+        f.move_q = f.move_q + (2.0 * f.move_angle + dalpha) * dalpha;
+        f.move_angle = f.move_angle + dalpha;
+    } else {
+        f.move_angle = 0.0;
+    }
 }
 
 /// Continuous-time F for the mean specific force f_n [m/s^2] and the mean

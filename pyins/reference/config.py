@@ -54,6 +54,8 @@ DEFAULT_NAV_GATE = 13.8155                   #: kDefaultNavGate: -2 ln(0.001)
 DEFAULT_NAV_REJECT_LIMIT = 10                #: kDefaultNavRejectLimit
 DEFAULT_REF_LATENCY_S = 1                    #: kDefaultRefLatencyS
 REF_HORIZON_S = 10                           #: kRefHorizonS
+MAX_NAV_GYRO_BIAS_RW = 1e-6                  #: kMaxNavGyroBiasRw [rad/s/sqrt(s)]
+MAX_NAV_TABLE_SIGMA = 0.01                   #: kMaxNavTableSigma
 NAV_SIGMA0_POS = 10.0                        #: kNavSigma0Pos [m]
 NAV_SIGMA0_VEL = 0.1                         #: kNavSigma0Vel [m/s]
 
@@ -126,6 +128,9 @@ def config_default():
         "dvl_align_rad": np.zeros(3),
         "dvl_lever_b_m": np.zeros(3),
         "gnss_lever_b_m": np.zeros(3),
+        "nav_gyro_bias_rw": 0.0,
+        "nav_table_scale_sigma": 0.0,
+        "nav_table_mis_sigma": 0.0,
     }
 
 
@@ -322,5 +327,12 @@ def config_check(raw):
             or cfg["nav_reject_limit"] < 1
             or not 1 <= cfg["ref_max_latency_ticks"] <= REF_HORIZON_S * hz):
         return abi.PYINS_E_CONFIG_NAV
+    # the filter's model beyond its bias states: 0 (not modelled) or a
+    # finite value within the bound (pyins_core.h)
+    model = (cfg["nav_gyro_bias_rw"], cfg["nav_table_scale_sigma"], cfg["nav_table_mis_sigma"])
+    bound = (MAX_NAV_GYRO_BIAS_RW, MAX_NAV_TABLE_SIGMA, MAX_NAV_TABLE_SIGMA)
+    for i in range(3):
+        if not (model[i] >= 0.0) or not (model[i] <= bound[i]):
+            return abi.PYINS_E_CONFIG_NAV
     return abi.PYINS_OK
 

@@ -580,7 +580,7 @@ class Firmware(NavAtSea):
                 # the biases the filter estimated, compensated (0 until it has)
                 dv_sf_n = strapdown.update(self.sd, dtheta_p - self.nav.gyro_bias * self.dt,
                                            dv_p - self.nav.accel_bias * self.dt, self.dt)
-                self.nav_tick(dv_sf_n)
+                self.nav_tick(dv_sf_n, dalpha)
                 self.blend_tick()
             else:
                 strapdown.update(self.sd, dtheta_p, dv_p, self.dt)

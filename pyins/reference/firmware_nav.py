@@ -102,7 +102,9 @@ class NavAtSea:
             dt=self.dt, every=cfg["nav_every_ticks"], reject_limit=cfg["nav_reject_limit"],
             gyro_arw=cfg["fine_gyro_arw"], accel_vrw=cfg["fine_accel_vrw"], gate=cfg["nav_gate"],
             sigma0_att=att, sigma0_vel=config.NAV_SIGMA0_VEL, sigma0_pos=config.NAV_SIGMA0_POS,
-            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"])
+            sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
+            gyro_bias_rw=cfg["nav_gyro_bias_rw"], table_scale=cfg["nav_table_scale_sigma"],
+            table_mis=cfg["nav_table_mis_sigma"])
         self.nav = nav_filter.init(prm, attitude.quat_to_mat(self.sd.nav.quat_np))
         self.nav_on = 1
         self.out_off = [0.0, 0.0, 0.0, 0.0]
@@ -117,8 +119,8 @@ class NavAtSea:
         return nav_filter.Motion(sin_lat, cos_lat, rm + nav.height, rn + nav.height,
                                  float(nav.vel_n[0]), float(nav.vel_n[1]))
 
-    def nav_tick(self, dv_sf_n):
-        nav_filter.gather(self.nav, dv_sf_n)
+    def nav_tick(self, dv_sf_n, dalpha):
+        nav_filter.gather(self.nav, dv_sf_n, dalpha)
         if self.nav.ticks == self.nav.prm.every:
             nav_filter.predict(self.nav, self.nav_motion(), attitude.quat_to_mat(self.sd.nav.quat_np))
             if self.nav.healthy == 0:

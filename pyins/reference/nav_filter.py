@@ -33,6 +33,9 @@ class Params:
     sigma0_pos: float
     sigma0_gyro: float
     sigma0_accel: float
+    gyro_bias_rw: float = 0.0   #: the biases' random walk [rad/s/sqrt(s)]; 0 = constants
+    table_scale: float = 0.0    #: sigma of the table-axis gyro's scale factor; 0 = none
+    table_mis: float = 0.0      #: sigma of the other gyros' misalignment to the table's axis [rad]
 
 
 @dataclass
@@ -55,6 +58,8 @@ class NavFilter:
     c_start: np.ndarray = field(default_factory=lambda: np.eye(3))
     ticks: int = 0
     healthy: int = 1
+    move_angle: float = 0.0
+    move_q: float = 0.0
     gyro_bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
     accel_bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
@@ -68,10 +73,18 @@ def init(prm, c_np):
     return NavFilter(prm=prm, p=np.diag(sigma * sigma), c_start=np.array(c_np, dtype=float))
 
 
-def gather(f, dv_sf_n):
-    """One tick's specific-force velocity increment in n' (mirrors gather)."""
+def gather(f, dv_sf_n, dalpha):
+    """One tick's specific-force velocity increment in n' and the table's
+    turn dalpha: the move's angle and the growth of its square (mirrors
+    gather)."""
     f.dv_sum = f.dv_sum + dv_sf_n
     f.ticks = f.ticks + 1
+    if dalpha != 0.0:
+        # (a + da)^2 - a^2
+        f.move_q = f.move_q + (2.0 * f.move_angle + dalpha) * dalpha
+        f.move_angle = f.move_angle + dalpha
+    else:
+        f.move_angle = 0.0
 
 
 def system_matrix(m, f_n, c_np):
@@ -133,6 +146,17 @@ def predict(f, m, c_np):
         f.p[PHI + i, PHI + i] = f.p[PHI + i, PHI + i] + q_att
     for i in (VEL, VEL + 1):
         f.p[i, i] = f.p[i, i] + q_vel
+    if f.prm.gyro_bias_rw > 0.0:
+        q_eps = f.prm.gyro_bias_rw * f.prm.gyro_bias_rw * span
+        for i in range(3):
+            f.p[EPS + i, EPS + i] = f.p[EPS + i, EPS + i] + q_eps
+    if f.move_q > 0.0:
+        q_tilt = f.prm.table_mis * f.prm.table_mis * f.move_q
+        q_head = f.prm.table_scale * f.prm.table_scale * f.move_q
+        f.p[PHI + 0, PHI + 0] = f.p[PHI + 0, PHI + 0] + q_tilt
+        f.p[PHI + 1, PHI + 1] = f.p[PHI + 1, PHI + 1] + q_tilt
+        f.p[PHI + 2, PHI + 2] = f.p[PHI + 2, PHI + 2] + q_head
+    f.move_q = 0.0
     f.p = 0.5 * (f.p + f.p.T)
     f.dv_sum = np.zeros(3)
     f.c_start = np.array(c_np, dtype=float)

@@ -191,7 +191,10 @@ def _firmware_config(res, motion):
                          ("fine_sigma0_att_rad", "fine_sigma0_att_rad"),
                          ("fine_sigma0_gyro_rad_s", "fine_sigma0_gyro"),
                          ("fine_sigma0_accel_mps2", "fine_sigma0_accel"),
-                         ("fine_site_accel_mps_sqrt_s", "fine_site_accel")):
+                         ("fine_site_accel_mps_sqrt_s", "fine_site_accel"),
+                         ("nav_gyro_bias_rw_rad_s_sqrt_s", "nav_gyro_bias_rw"),
+                         ("nav_table_scale_sigma", "nav_table_scale_sigma"),
+                         ("nav_table_mis_sigma_rad", "nav_table_mis_sigma")):
         if fw[name] is not None:
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
@@ -289,7 +292,10 @@ _FIELD_KEYS = {"lat_rad": "motion.lat", "lon_rad": "motion.lon", "height_m": "mo
                "coarse_method": "firmware.coarse_method", "fine_states": "firmware.fine_states",
                "fine_gyro_arw": "firmware.fine_gyro_arw", "fine_accel_vrw": "firmware.fine_accel_vrw",
                "fine_sigma0_att_rad": "firmware.fine_sigma0_att",
-               "fine_site_accel": "firmware.fine_site_accel"}
+               "fine_site_accel": "firmware.fine_site_accel",
+               "nav_gyro_bias_rw": "firmware.nav_gyro_bias_rw",
+               "nav_table_scale_sigma": "firmware.nav_table_scale_sigma",
+               "nav_table_mis_sigma": "firmware.nav_table_mis_sigma"}
 
 
 def _firmware_check(motion, cfg):

@@ -306,6 +306,19 @@ FIRMWARE_KEYS = {
                                                    "a white acceleration density (firmware default 0: "
                                                    "a rigid site)", lo="0 ug/sqrt(Hz)",
                            hi="10 mg/sqrt(Hz)"),
+    "nav_gyro_bias_rw": Key("rate_random_walk", "navigation filter: the gyro biases' random walk, "
+                                                "their instability (firmware default 0: random "
+                                                "constants)", lo="0 deg/h/sqrt(h)",
+                            hi="1e-6 rad/s/sqrt(s)"),
+    "nav_table_scale_sigma": Key("dimensionless", "navigation filter: sigma of the scale factor of "
+                                                  "the gyro on the table's axis, a heading error of "
+                                                  "that fraction of every table move (firmware "
+                                                  "default 0: not modelled; the IMU's own figure, "
+                                                  "e.g. 10 ppm)", lo=0.0, hi=0.01),
+    "nav_table_mis_sigma": Key("angle", "navigation filter: sigma of the other gyros' misalignment "
+                                        "to the table's axis, a tilt of at most that fraction of a "
+                                        "move (firmware default 0: not modelled; e.g. 10 arcsec)",
+                               lo="0 arcsec", hi="0.01 rad"),
 }
 
 INITIAL_ERROR_KEYS = {
@@ -438,7 +451,7 @@ TABLES = {"motion": MOTION_COMMON, "sensors": SENSOR_KEYS, "turntable": TURNTABL
           "compare": COMPARE_KEYS, "paper": PAPER_KEYS, "outputs": OUTPUT_KEYS}
 
 _SUFFIX = {"angle": "_rad", "angular_rate": "_rad_s", "angular_acceleration": "_rad_s2",
-           "angle_random_walk": "_rad_sqrt_s", "acceleration": "_mps2",
+           "angle_random_walk": "_rad_sqrt_s", "acceleration": "_mps2", "rate_random_walk": "_rad_s_sqrt_s",
            "velocity_random_walk": "_mps_sqrt_s", "velocity": "_mps", "length": "_m", "time": "_s",
            "frequency": "_hz", "dimensionless": ""}
 

@@ -61,6 +61,10 @@ FIELDS = {
     "dvl_lever_b_m": values([0.0, 0.0, 0.0], [0.0, 60.0, -80.0], [0.0, 60.0, -80.1], [0.0, 0.0, -INF]),
     # the GNSS antenna's lever arm: at most 100 m
     "gnss_lever_b_m": values([0.0, 0.0, 0.0], [1.0, 5.0, 25.0], [0.0, 80.0, 60.1], [NAN, 0.0, 0.0]),
+    "nav_gyro_bias_rw": values(0.0, 1e-11, config.MAX_NAV_GYRO_BIAS_RW,
+                               np.nextafter(config.MAX_NAV_GYRO_BIAS_RW, 1.0), -1e-12, NAN, INF),
+    "nav_table_scale_sigma": values(0.0, 1e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, NAN),
+    "nav_table_mis_sigma": values(0.0, 4.8e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, INF),
 }
 
 

@@ -37,20 +37,31 @@ def test_system_matrix(lat, ve, vn, f, euler):
     assert np.array_equal(got, want)
 
 
-def _params(every):
+def _params(every, model=False):
+    """model: the filter's model beyond its bias states on (a bias random
+    walk, the table's scale factor and misalignment), else off."""
     return nav_filter.Params(dt=DT, every=every, reject_limit=10, gyro_arw=0.001 * DEG_TO_RAD / 60.0,
                              accel_vrw=10e-6 * G0, gate=13.8155,
                              sigma0_att=np.array([1.0, 1.0, 10.0]) * ARCMIN_TO_RAD, sigma0_vel=0.1,
                              sigma0_pos=10.0, sigma0_gyro=0.01 * DEG_TO_RAD / 3600.0,
-                             sigma0_accel=100e-6 * G0)
+                             sigma0_accel=100e-6 * G0,
+                             gyro_bias_rw=(0.001 * DEG_TO_RAD / 3600.0 / 60.0) if model else 0.0,
+                             table_scale=10e-6 if model else 0.0,
+                             table_mis=(10.0 / 206264.8) if model else 0.0)
 
 
 @settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 10_000), every=st.sampled_from([1, 7, 100]), n=st.integers(50, 700),
-       lat=st.floats(-70.0, 70.0), speed=st.floats(0.0, 12.0), outlier=st.booleans())
-def test_filter_run(seed, every, n, lat, speed, outlier):
+       lat=st.floats(-70.0, 70.0), speed=st.floats(0.0, 12.0), outlier=st.booleans(),
+       model=st.booleans())
+def test_filter_run(seed, every, n, lat, speed, outlier, model):
     rng = np.random.default_rng(seed)
-    prm = _params(every)
+    prm = _params(every, model)
+    # the table: still, then moves of 0.1 rad a tick for a random number of
+    # ticks either way, still again (the move's angle restarts at each stop)
+    dalpha = np.zeros(n)
+    for start in rng.integers(0, n, 3):
+        dalpha[start:start + rng.integers(1, 40)] = rng.choice([-0.1, 0.1])
     yaw = rng.uniform(-np.pi, np.pi, n)
     euler = np.column_stack([rng.normal(0, 0.05, n), rng.normal(0, 0.05, n), np.cumsum(np.full(n, 0.001)) + yaw[0]])
     c = np.array([attitude.euler_to_mat(e) for e in euler])
@@ -66,7 +77,7 @@ def test_filter_run(seed, every, n, lat, speed, outlier):
     f = nav_filter.init(prm, c[0])
     nis_ref = np.zeros(n)
     for k in range(n):
-        nav_filter.gather(f, dv[k])
+        nav_filter.gather(f, dv[k], dalpha[k])
         if f.ticks == f.prm.every:
             nav_filter.predict(f, motions[k], c[k])
         if kind[k]:
@@ -79,17 +90,17 @@ def test_filter_run(seed, every, n, lat, speed, outlier):
                 f.c_start = c[k]
     p = ffi.new("pyins_t_nav_params *")
     for name in ("dt", "every", "reject_limit", "gyro_arw", "accel_vrw", "gate", "sigma0_vel",
-                 "sigma0_pos", "sigma0_gyro", "sigma0_accel"):
+                 "sigma0_pos", "sigma0_gyro", "sigma0_accel", "gyro_bias_rw", "table_scale", "table_mis"):
         setattr(p, name, getattr(prm, name))
     p.sigma0_att = list(prm.sigma0_att)
     keep = [np.ascontiguousarray(a, dtype=np.float64) for a in
-            (c[0], dv, [_m6(m) for m in motions], c.reshape(n, 9), z, r)]
+            (c[0], dv, dalpha, [_m6(m) for m in motions], c.reshape(n, 9), z, r)]
     kinds = np.ascontiguousarray(kind)
     nis = np.zeros(n)
     x_out, p_out, b_out = np.zeros(12), np.zeros(144), np.zeros(6)
     ptr = [ffi.from_buffer("double[]", a) for a in keep]
-    lib.pyins_t_nav_filter_run(p, ptr[0], ptr[1], ptr[2], ptr[3], ffi.from_buffer("int32_t[]", kinds),
-                               ptr[4], ptr[5], n, ffi.from_buffer("double[]", nis),
+    lib.pyins_t_nav_filter_run(p, ptr[0], ptr[1], ptr[2], ptr[3], ptr[4], ffi.from_buffer("int32_t[]", kinds),
+                               ptr[5], ptr[6], n, ffi.from_buffer("double[]", nis),
                                ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", p_out),
                                ffi.from_buffer("double[]", b_out))
     # summation order differs (Eigen's coefficient products, NumPy's @): 1e-9 relative
