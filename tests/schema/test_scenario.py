@@ -23,7 +23,8 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
             "seed002_exp1", "seed002_exp2", "seed003",
             "moored_bad", "moored_general", "moored_ideal", "moored_spectrum",   # test_scenario_ship.py
             "harbour_ranging",                                                  # test_harbour_ranging.py
-            "voyage_gnss", "voyage_gnss_outages", "voyage_log", "voyage_dvl"]   # tests/atsea/test_scenario_refs.py
+            "voyage_gnss", "voyage_gnss_outages", "voyage_log", "voyage_dvl",   # tests/atsea/test_scenario_refs.py
+            "pier_indexed"]                                                     # tests/physics/test_indexed_alignment.py
 
 
 def _tool(name):

@@ -1,0 +1,63 @@
+"""Alignment below the static limit by indexing the table (the built-in
+scenario `pier_indexed`, tools/indexed_alignment.py): coarse 120 s, then the
+navigation filter aided by zero velocity with the table indexed between two
+positions, against the static limit eps_E / (Omega cos L) of each draw of
+seed 000's errors; and the same filter with the table fixed, which cannot
+beat it (the indexing is what separates the drift from the heading)."""
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import chi2
+
+from pyins.units import ARCMIN_TO_RAD
+
+ROOT = Path(__file__).resolve().parents[2]
+DRAWS = range(12)           # two of each heading 0, 60, ... 300 deg
+
+
+def _tool():
+    spec = importlib.util.spec_from_file_location("indexed_alignment", ROOT / "tools" / "indexed_alignment.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_indexing_beats_the_static_limit():
+    tool = _tool()
+    err, sig, lim = [], [], []
+    for d in DRAWS:
+        t, h, s, limit = tool.one(d, 60.0, static=False)
+        k = int(np.searchsorted(t, 599.0))
+        err.append(h[k])
+        sig.append(s[k])
+        lim.append(limit)
+    err, sig, lim = map(np.abs, (err, sig, lim))
+    print(f"\nmedian |heading| at 600 s: indexed {np.median(err) / ARCMIN_TO_RAD:.3f}', static limit "
+          f"{np.median(lim) / ARCMIN_TO_RAD:.3f}'; NEES {np.mean((err / sig) ** 2):.2f}")
+    # the issue's bar: at most half the static limit (median over the draws);
+    # measured 0.13 of it over 30 draws (docs/results/indexed_alignment.md)
+    assert np.median(err) <= 0.5 * np.median(lim)
+    # the filter's sigma says how sure it is: the NEES inside chi-square(n) / n's 95 % bounds
+    n = len(err)
+    assert chi2.ppf(0.025, n) / n <= np.mean((err / sig) ** 2) <= chi2.ppf(0.975, n) / n
+
+
+def test_a_fixed_table_stays_at_the_static_limit():
+    """The same filter and zero velocity, the table never moved: the heading
+    error is pinned by the drift as the static limit says (the same sign, at
+    least 0.7 of it: a fixed IMU converges towards the limit from the coarse
+    start, 0.82 of it at worst over these draws when the test was written),
+    nowhere near the indexed alignment's 0.13."""
+    tool = _tool()
+    from pyins import metrics, scenario
+    from pyins.run_scenario import run
+    from pyins.sim.sensors import random_constant_overrides
+    for d in (0, 1, 3):
+        _, _, _, limit = tool.one(d, 60.0, static=False)
+        over = dict(random_constant_overrides("seed000", d), seed=d,
+                    **{"motion.heading": f"{60 * (d % 6)} deg", "indexing.scheme": "none"})
+        res = run(next(iter(scenario.load("pier_indexed").with_overrides(over).runs())))
+        e = metrics.nav_errors(res)
+        k = int(np.searchsorted(e.time_s, 599.0))
+        assert e.att_n_rad[k, 2] / limit >= 0.7, (d, e.att_n_rad[k, 2], limit)
