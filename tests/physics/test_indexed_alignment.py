@@ -1,5 +1,5 @@
 """Alignment below the static limit by indexing the table (the built-in
-scenario `pier_indexed`, tools/indexed_alignment.py): coarse 120 s, then the
+scenarios `pier_indexed` and `moored_indexed`, tools/indexed_alignment.py): coarse 120 s, then the
 navigation filter aided by zero velocity with the table indexed between two
 positions, against the static limit eps_E / (Omega cos L) of each draw of
 seed 000's errors; and the same filter with the table fixed, which cannot
@@ -61,3 +61,21 @@ def test_a_fixed_table_stays_at_the_static_limit():
         e = metrics.nav_errors(res)
         k = int(np.searchsorted(e.time_s, 599.0))
         assert e.att_n_rad[k, 2] / limit >= 0.7, (d, e.att_n_rad[k, 2], limit)
+
+
+def test_a_moored_ship_with_gnss_beats_the_static_limit():
+    """moored_indexed: the heaving, surging, swaying ship with its lever arm,
+    FIT coarse 120 s, then the filter aided by GNSS (3 m, 0.05 m/s) with the
+    table indexed: at most half the static limit (median over six draws;
+    measured 0.197 of it over 30, docs/results/indexed_alignment_moored_3m.md).
+    Its sigma is on the cautious side there (NEES 0.22 over 30 draws: the
+    prior fitted to the coarse result, times 3, is most of what 480 s of 3 m
+    fixes leave), so no NEES bound is held here; RTK-grade fixes make it
+    consistent (0.95)."""
+    tool = _tool()
+    err, lim = [], []
+    for d in range(6):
+        t, h, _, limit = tool.one(d, 60.0, static=False, site="moored")
+        err.append(h[int(np.searchsorted(t, 599.0))])
+        lim.append(limit)
+    assert np.median(np.abs(err)) <= 0.5 * np.median(np.abs(lim))

@@ -24,7 +24,7 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
             "moored_bad", "moored_general", "moored_ideal", "moored_spectrum",   # test_scenario_ship.py
             "harbour_ranging",                                                  # test_harbour_ranging.py
             "voyage_gnss", "voyage_gnss_outages", "voyage_log", "voyage_dvl",   # tests/atsea/test_scenario_refs.py
-            "pier_indexed"]                                                     # tests/physics/test_indexed_alignment.py
+            "pier_indexed", "moored_indexed"]                                   # tests/physics/test_indexed_alignment.py
 
 
 def _tool(name):
