@@ -181,9 +181,12 @@ enum pyins_fault_flag {
     PYINS_FAULT_SEQ_REPEAT = 32,  /* a duplicate sample was dropped (n_seq_repeats) */
     PYINS_FAULT_SEQ_LOST = 64,    /* the sequence broke beyond the bridgeable gap (n_seq_lost) */
     PYINS_FAULT_ENCODER_JUMP = 128, /* the encoder jumped (n_encoder_jumps) */
-    PYINS_FAULT_ALIGN_INCONSISTENT = 256, /* the fine alignment's measurements do not fit its model:
-                                             a window's mean normalised innovation squared (align_nis)
-                                             beyond integrity_nis_max; the attitude is not valid */
+    PYINS_FAULT_ALIGN_INCONSISTENT = 256, /* the alignment's measurements do not fit its model: the
+                                             fine alignment's window mean normalised innovation squared
+                                             (align_nis) beyond integrity_nis_max, or a reference
+                                             velocity during an alignment says the site moves (more
+                                             than 0.5 m/s beyond its noise and lever arm: a ship under
+                                             way, ABI 0.18); the attitude is not valid */
     PYINS_FAULT_COARSE_UNSETTLED = 512, /* the coarse solution kept moving over the last fifth of the
                                           coarse alignment by more than integrity_coarse_rad
                                           (coarse_wander_rad); the attitude is not valid */

@@ -97,6 +97,14 @@ inline constexpr int32_t kRefHorizonS = 10;
 /// bound catches a value in the wrong unit).
 inline constexpr double kMaxNavGyroBiasRw = 1e-6;
 inline constexpr double kMaxNavTableSigma = 0.01;
+/// The fastest a site may move during an alignment [m/s], beyond a
+/// reference velocity's noise (3 sigma) and its lever arm's rotation: the
+/// waves move a moored ship's reference point by at most ~0.25 m/s (seed
+/// 000's sea states with 0.3 m of surge and sway), and a ship making 0.5 m/s
+/// over ground turns the frame the coarse alignment takes for fixed by its
+/// transport rate, a heading bias of v / (R Omega cos L): 4.5' at 34 deg,
+/// 10' at 70 deg. Faster, the alignment cannot be right.
+inline constexpr double kAlignMaxSpeed = 0.5;
 /// Initial sigmas of the navigation filter's position and velocity when
 /// navigation starts from an alignment at the site [m, m/s] (the site's
 /// survey; the alignment's velocity residual), and of its attitude when no

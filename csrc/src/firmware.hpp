@@ -282,6 +282,9 @@ class Firmware {
     void reject_ref(int32_t slot);
     /// A reference of kind slot + 1 passed its gate: counted, the kind in use.
     void use_ref(int32_t slot);
+    /// A reference that came before navigation: counted as skipped; during
+    /// an alignment, a velocity that says the site moves ends its integrity.
+    void skip_ref(const pyins_ref& ref);
     /// Apply the references whose tick has come (tick_ just advanced).
     void refs_due();
     /// Gate and apply one reference now (lag: ticks since its tick).

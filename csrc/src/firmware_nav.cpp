@@ -192,9 +192,38 @@ int Firmware::push_ref(const pyins_ref& ref) {
     if (mode_ == Mode::kNavigate && nav_on_ != 0) {
         apply_ref(ref, tick_ - ref.tick);
     } else {
-        count(&n_ref_skipped_[ref.kind - 1], 1u);
+        skip_ref(ref);
     }
     return PYINS_OK;
+}
+
+void Firmware::skip_ref(const pyins_ref& ref) {
+    count(&n_ref_skipped_[ref.kind - 1], 1u);
+    if ((mode_ != Mode::kCoarseAlign && mode_ != Mode::kFineAlign) ||
+        (ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_DVL)) {
+        return;
+    }
+    // The reference point's speed: GNSS's horizontal, the DVL's along its
+    // three axes (bottom track: over ground; the heave's share is inside
+    // the bound). The antenna or the DVL moves by w x l beyond it.
+    const bool gnss = ref.kind == PYINS_REF_GNSS_VEL;
+    const double* l = gnss ? cfg_.gnss_lever_b_m : cfg_.dvl_lever_b_m;
+    double speed_sq = ref.value[0] * ref.value[0] + ref.value[1] * ref.value[1];
+    double sigma = ref.sigma[0] > ref.sigma[1] ? ref.sigma[0] : ref.sigma[1];
+    if (!gnss) {
+        speed_sq = speed_sq + ref.value[2] * ref.value[2];
+        sigma = sigma > ref.sigma[2] ? sigma : ref.sigma[2];
+    }
+    double lever_speed = 0.0;
+    if (rates_on_ != 0) {
+        const double w_sq = rate_p_(0) * rate_p_(0) + rate_p_(1) * rate_p_(1) + rate_p_(2) * rate_p_(2);
+        lever_speed = pmath::sqrt(w_sq * (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]));
+    }
+    const double bound = config::kAlignMaxSpeed + 3.0 * sigma + lever_speed;
+    if (speed_sq > bound * bound) {
+        faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
+        integrity_lost_ = 1;
+    }
 }
 
 void Firmware::refs_due() {
@@ -203,7 +232,7 @@ void Firmware::refs_due() {
         if (mode_ == Mode::kNavigate && nav_on_ != 0) {
             apply_ref(ref, tick_ - ref.tick);
         } else {
-            count(&n_ref_skipped_[ref.kind - 1], 1u);
+            skip_ref(ref);
         }
         refq_head_ = (refq_head_ + 1) % kRefQueue;
         refq_count_ = refq_count_ - 1;

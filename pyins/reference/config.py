@@ -56,6 +56,7 @@ DEFAULT_REF_LATENCY_S = 1                    #: kDefaultRefLatencyS
 REF_HORIZON_S = 10                           #: kRefHorizonS
 MAX_NAV_GYRO_BIAS_RW = 1e-6                  #: kMaxNavGyroBiasRw [rad/s/sqrt(s)]
 MAX_NAV_TABLE_SIGMA = 0.01                   #: kMaxNavTableSigma
+ALIGN_MAX_SPEED = 0.5                        #: kAlignMaxSpeed [m/s]
 NAV_SIGMA0_POS = 10.0                        #: kNavSigma0Pos [m]
 NAV_SIGMA0_VEL = 0.1                         #: kNavSigma0Vel [m/s]
 

@@ -315,8 +315,33 @@ class NavAtSea:
         if self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on:
             self.apply_ref(ref, self.tick - tick)
         else:
-            self.n_ref_skipped[kind - 1] = count(self.n_ref_skipped[kind - 1])
+            self.skip_ref(ref)
         return abi.PYINS_OK
+
+    def skip_ref(self, ref):
+        """Counted as skipped; during an alignment a velocity that says the
+        site moves ends its integrity (mirrors skip_ref)."""
+        kind, _, value, sigma = ref
+        self.n_ref_skipped[kind - 1] = count(self.n_ref_skipped[kind - 1])
+        if (self.mode not in (abi.PYINS_MODE_COARSE_ALIGN, abi.PYINS_MODE_FINE_ALIGN)
+                or kind not in (abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_DVL)):
+            return
+        gnss = kind == abi.PYINS_REF_GNSS_VEL
+        lv = self.cfg["gnss_lever_b_m"] if gnss else self.cfg["dvl_lever_b_m"]
+        speed_sq = value[0] * value[0] + value[1] * value[1]
+        sig = sigma[0] if sigma[0] > sigma[1] else sigma[1]
+        if not gnss:
+            speed_sq = speed_sq + value[2] * value[2]
+            sig = sig if sig > sigma[2] else sigma[2]
+        lever_speed = 0.0
+        if self.rates_on:
+            w = self.rate_p
+            w_sq = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
+            lever_speed = math.sqrt(w_sq * (lv[0] * lv[0] + lv[1] * lv[1] + lv[2] * lv[2]))
+        bound = config.ALIGN_MAX_SPEED + 3.0 * sig + lever_speed
+        if speed_sq > bound * bound:
+            self.faults = self.faults | abi.PYINS_FAULT_ALIGN_INCONSISTENT
+            self.integrity_lost = 1
 
     def refs_due(self):
         while self.refq and self.refq[0][1] <= self.tick:
@@ -324,7 +349,7 @@ class NavAtSea:
             if self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on:
                 self.apply_ref(ref, self.tick - ref[1])
             else:
-                self.n_ref_skipped[ref[0] - 1] = count(self.n_ref_skipped[ref[0] - 1])
+                self.skip_ref(ref)
 
     def apply_ref(self, ref, lag):
         kind, _, value, sigma = ref
