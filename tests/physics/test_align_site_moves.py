@@ -13,12 +13,10 @@ from pyins.run_scenario import run
 ARCMIN = np.pi / 180.0 / 60.0
 
 
-def _under_way(gnss=True):
+def _under_way():
     over = {"duration": "300 s", "firmware.initial_attitude": "zero", "firmware.coarse_time": "120 s",
             "firmware.coarse_method": "fit", "initial_errors": None, "sensors.preset": "seed000",
             "firmware.fine_sigma0_att": None}
-    if not gnss:
-        over["references"] = None
     return run(next(iter(scenario.load("voyage_gnss").with_overrides(over).runs())))
 
 
