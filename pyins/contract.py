@@ -157,7 +157,8 @@ _STATUS_MEANING = {
     "PYINS_E_CONFIG_NAV": "nav_mode must be AUTO, UNDAMPED, DAMPED or INTEGRATED, nav_every_ticks 1..10 s, "
                           "nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks "
                           "1..10 s (0 = default); nav_gyro_bias_rw 0..1e-6 rad/s/sqrt(s), "
-                          "nav_table_scale_sigma and nav_table_mis_sigma 0..0.01 (0 = not modelled)",
+                          "nav_table_scale_sigma, nav_table_mis_sigma, nav_level_scale_sigma and nav_level_mis_sigma "
+                          "0..0.01 (0 = not modelled)",
     "PYINS_E_REF_KIND": "unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, "
                         "SPEED_LOG, DVL bottom track, ZERO_VEL are used; a DVL with reserved != 0, water "
                         "track, is not)",

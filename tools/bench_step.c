@@ -30,7 +30,7 @@ int main(int argc, char **argv) {
     const char *name = argc > 2 ? argv[2] : "nav";
     const char *api_name = argc > 3 ? argv[3] : "step";
     const int mode = bench_mode_of(name);
-    static unsigned char mem[1 << 14] __attribute__((aligned(64)));
+    static unsigned char mem[20 * 1024] __attribute__((aligned(64)));
     static pyins_sample block[BLOCK];
     static pyins_output records[BLOCK + 1];
     static pyins_nav navs[BLOCK + 1];

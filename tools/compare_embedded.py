@@ -84,7 +84,8 @@ def python_lines():
                fine_site_accel=0.009765625, dvl_align_rad=[0.0078125, -0.0078125, 0.5],
                dvl_lever_b_m=[0.25, 2.0, -3.0], gnss_lever_b_m=[0.5, 2.0, 12.5],
                nav_gyro_bias_rw=5.820766091346741e-11, nav_table_scale_sigma=1.52587890625e-05,
-               nav_table_mis_sigma=6.103515625e-05)
+               nav_table_mis_sigma=6.103515625e-05, nav_level_scale_sigma=1.52587890625e-05,
+               nav_level_mis_sigma=6.103515625e-05)
     fw = native.Firmware(cfg)
     lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
     states = {"samples": 1, "refs": 12345}

@@ -12,7 +12,9 @@ The voyage of tests/atsea/test_integrated_gnss.py
 and +61 deg, the general sea state's swing and heave), seed 002's sensor
 errors with their noise, the IMU fixed, an initial attitude error of 1',
 -1', 5', a 1 Hz GNSS (3 m / 0.05 m/s, a 2 m Gauss-Markov bias over 300 s)
-with 1 % of its fixes jumped 50-500 m. Both engines take the same
+with 1 % of its fixes jumped 50-500 m; the filter told seed 002's grade of
+scale factor and misalignment (10 ppm, 10") as its seven states for them
+(ABI 0.19). Both engines take the same
 increments and references (`pyins.open_loop.navigate`, engine "native" and
 "reference"); a record every ``--every`` ticks. Compared: the integers
 (tick, modes, fault and state bits, the per-kind reference counters)
@@ -20,7 +22,8 @@ exactly; position, velocity, attitude, the filter's sigmas, NIS and bias
 estimates as the largest difference. Exit 1 when a decision differs or a
 float exceeds its bound: those of the 60-s test (position 1e-12 rad,
 velocity 1e-9 m/s, quaternion 0.5e-10, sigmas 1e-9 relative + 1e-12, gyro
-bias 1e-15 rad/s), the NIS 1e-6 absolute (FLOATS says why).
+bias 1e-15 rad/s), the NIS 1e-6 absolute, the scale factors and
+misalignments 1e-12 (FLOATS says why).
 """
 import argparse
 import json
@@ -41,7 +44,11 @@ INTEGERS = ("tick", "mode", "nav_mode", "ref_in_use", "n_ref_used", "n_ref_rejec
 # (field, bound, relative?): the 60-s test's bounds (tests/atsea/test_integrated_gnss.py)
 FLOATS = (("lat_rad", 1e-12, False), ("lon_rad", 1e-12, False), ("vel_n_mps", 1e-9, False),
           ("quat_np", 0.5e-10, False), ("nav_sigma_pos_m", 1e-9, True), ("nav_sigma_heading_rad", 1e-9, True),
-          ("nav_nis", 1e-6, False), ("nav_gyro_bias_rad_s", 1e-15, False), ("nav_accel_bias_mps2", 1e-12, False))
+          ("nav_nis", 1e-6, False), ("nav_gyro_bias_rad_s", 1e-15, False), ("nav_accel_bias_mps2", 1e-12, False),
+          ("nav_table_err", 1e-12, False), ("nav_level_err", 1e-12, False))
+# The scale-factor and misalignment estimates (ABI 0.19; priors 10 ppm, 10" = 4.8e-5 rad): 1e-12
+# absolute is 2e-8 of their prior sigma, as the gyro biases' 1e-15 rad/s is 2e-8 of seed 002's
+# 0.003 deg/h.
 # The NIS is held absolutely over the hour (the 60-s test: 1e-9 relative + 1e-12): the engines'
 # ulps grow with time (velocity 1.7e-11 m/s after 1 h, measured), and a small NIS's relative
 # difference grows faster (1.1e-8 at a NIS of 0.007, 2026-12-05). What a NIS decides is its gate,
@@ -59,8 +66,11 @@ def main(argv=None):
     motion = sim.default_voyage(args.hours, seed=1)
     g = references.gnss(motion, n * DT, seed=5, outlier_rate=0.01, outlier_m=(50.0, 500.0))
     refs, avail = g.refs.astype(contract.REF_DTYPE), g.avail_tick
+    mis = 10.0 * ARCMIN_TO_RAD / 60.0
     cfg = dict(initial_errors(motion, phi=np.array([1.0, -1.0, 5.0]) * ARCMIN_TO_RAD),
-               fine_sigma0_att_rad=np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD)
+               fine_sigma0_att_rad=np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD,
+               nav_table_scale_sigma=10e-6, nav_table_mis_sigma=mis, nav_level_scale_sigma=10e-6,
+               nav_level_mis_sigma=mis)
     out, wall = {}, {}
     for engine in ("native", "reference"):
         t0 = time.perf_counter()

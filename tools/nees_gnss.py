@@ -5,7 +5,8 @@ against the chi-square 95 % bounds (the at-sea issue's acceptance 2).
 
     .venv/bin/python tools/nees_gnss.py [--seeds 30] [--hours 2] [--errors model|seed002|seed002-draws]
                                         [--prior default|seed002] [--bias 0] [--indexing]
-                                        [--table-scale 0] [--table-mis 0] [--bias-rw 0]
+                                        [--table-scale 0] [--table-mis 0] [--level-scale 0]
+                                        [--level-mis 0] [--bias-rw 0]
                                         [--workers 1]
 
 Each run (seed s = 0 .. seeds - 1) navigates `pyins.sim.default_voyage`
@@ -32,8 +33,12 @@ consistency over a production of units.
 the defaults (0.01 deg/h, 100 ug, 0.001 deg/sqrt(h), 10 ug/sqrt(Hz)); with
 ``--errors model`` the biases and the noise are then drawn from that.
 ``--table-scale``, ``--table-mis``: the filter's nav_table_scale_sigma
-[ppm] and nav_table_mis_sigma [arcsec] (the heading and the tilt each table
-move exposes; seed 002's gyros: 10 ppm, 10 arcsec); ``--bias-rw`` its
+[ppm] and nav_table_mis_sigma [arcsec] (the priors of its table-axis error
+states: the heading and the tilt each table move exposes; seed 002's gyros:
+10 ppm, 10 arcsec); ``--level-scale``, ``--level-mis``: its
+nav_level_scale_sigma [ppm] and nav_level_mis_sigma [arcsec] (the level
+gyros' scale factors and misalignments, through which the Earth's rate
+gives a heading error indexing does not remove); ``--bias-rw`` its
 nav_gyro_bias_rw [deg/h/sqrt(h)] (0: the biases random constants).
 GNSS at 1 Hz: 3 m (5 m up) white, 0.05 m/s; ``--bias`` the receiver's
 Gauss-Markov bias [m] (300 s), which the filter does not model (0: none).
@@ -71,7 +76,8 @@ PRIORS = {"default": (GYRO_BIAS, ACCEL_BIAS, GYRO_ARW, ACCEL_VRW),
           "seed002": (0.003 * DEG_TO_RAD / 3600.0, 30e-6 * G0, 0.0005 * DEG_TO_RAD / 60.0, 5e-6 * G0)}
 
 
-def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0, 0.0), bias_rw=0.0):
+def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0, 0.0), bias_rw=0.0,
+            level=(0.0, 0.0)):
     gyro_prior, accel_prior, arw, vrw = PRIORS[prior]
     rng = np.random.default_rng(1000 + seed)
     if errors == "model":
@@ -92,7 +98,8 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0
     if prior != "default":
         cfg.update(fine_sigma0_gyro=gyro_prior, fine_sigma0_accel=accel_prior, fine_gyro_arw=arw,
                    fine_accel_vrw=vrw)
-    cfg.update(nav_table_scale_sigma=table[0] * 1e-6, nav_table_mis_sigma=table[1] * ARCMIN_TO_RAD / 60.0)
+    cfg.update(nav_table_scale_sigma=table[0] * 1e-6, nav_table_mis_sigma=table[1] * ARCMIN_TO_RAD / 60.0,
+               nav_level_scale_sigma=level[0] * 1e-6, nav_level_mis_sigma=level[1] * ARCMIN_TO_RAD / 60.0)
     cfg.update(nav_gyro_bias_rw=bias_rw * DEG_TO_RAD / 3600.0 / 60.0)
     g = references.gnss(motion, n * DT, seed=2000 + seed, bias_sigma_m=bias)
     refs = g.refs.astype(contract.REF_DTYPE)
@@ -106,7 +113,7 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0
     o = res.outputs
     head = (e.att_n_rad[:, 2] / o["nav_sigma_heading_rad"]) ** 2
     hor = (e.north_m ** 2 + e.east_m ** 2) / o["nav_sigma_pos_m"] ** 2
-    return e.time_s, head, hor, e.att_n_rad[:, 2]
+    return e.time_s, head, hor, e.att_n_rad[:, 2], np.hypot(e.east_m, e.north_m)
 
 
 _MOTIONS = {}
@@ -115,10 +122,10 @@ _MOTIONS = {}
 def _run_seed(a):
     """One seed, in this process or a worker; the voyage built once per
     process (deterministic: route seed 1), not sent to the workers."""
-    hours, n, s, (errors, bias, indexing, prior, table, bias_rw) = a
+    hours, n, s, (errors, bias, indexing, prior, table, bias_rw, level) = a
     if hours not in _MOTIONS:
         _MOTIONS[hours] = sim.default_voyage(hours, seed=1)
-    return one_run(_MOTIONS[hours], n, s, errors, bias, indexing, prior, table, bias_rw)
+    return one_run(_MOTIONS[hours], n, s, errors, bias, indexing, prior, table, bias_rw, level)
 
 
 class _Inline:
@@ -148,6 +155,10 @@ def main():
                     help="the filter's nav_table_scale_sigma [ppm] (seed 002's gyros: 10)")
     ap.add_argument("--table-mis", type=float, default=0.0,
                     help="the filter's nav_table_mis_sigma [arcsec] (seed 002's gyros: 10)")
+    ap.add_argument("--level-scale", type=float, default=0.0,
+                    help="the filter's nav_level_scale_sigma [ppm] (seed 002's gyros: 10)")
+    ap.add_argument("--level-mis", type=float, default=0.0,
+                    help="the filter's nav_level_mis_sigma [arcsec] (seed 002's gyros: 10)")
     ap.add_argument("--bias-rw", type=float, default=0.0,
                     help="the filter's gyro bias random walk, nav_gyro_bias_rw [deg/h/sqrt(h)]")
     ap.add_argument("--workers", type=int, default=1, help="runs at once (processes); the figures do not "
@@ -157,14 +168,16 @@ def main():
         ap.error("--workers: at least 1")
     n = int(round(args.hours * 3600.0 / DT))
     t0 = time.perf_counter()
-    heads, hors, errs = [], [], []
-    job = (args.errors, args.bias, args.indexing, args.prior, (args.table_scale, args.table_mis), args.bias_rw)
+    heads, hors, errs, herrs = [], [], [], []
+    job = (args.errors, args.bias, args.indexing, args.prior, (args.table_scale, args.table_mis), args.bias_rw,
+           (args.level_scale, args.level_mis))
     with concurrent.futures.ProcessPoolExecutor(args.workers) if args.workers > 1 else _Inline() as pool:
         runs = pool.map(_run_seed, [(args.hours, n, s, job) for s in range(args.seeds)])
-        for s, (t, h, p, err) in enumerate(runs):
+        for s, (t, h, p, err, herr) in enumerate(runs):
             heads.append(h)
             hors.append(p)
             errs.append(err)
+            herrs.append(herr)
             print(f"  run {s + 1}/{args.seeds}: mean NEES heading {h[t >= 600].mean():.2f}, horizontal "
                   f"{p[t >= 600].mean():.2f} ({time.perf_counter() - t0:.0f} s)", flush=True)
     head, hor = np.mean(heads, axis=0), np.mean(hors, axis=0)
@@ -175,12 +188,15 @@ def main():
     print(f"\nvoyage {args.hours:g} h, {N} runs, errors {args.errors}, prior {args.prior}, "
           f"GNSS bias {args.bias:g} m, "
           f"{'two-position indexing' if args.indexing else 'IMU fixed'}, nav_table_scale_sigma "
-          f"{args.table_scale:g} ppm, nav_table_mis_sigma {args.table_mis:g} arcsec, bias random walk "
+          f"{args.table_scale:g} ppm, nav_table_mis_sigma {args.table_mis:g} arcsec, nav_level_scale_sigma "
+          f"{args.level_scale:g} ppm, nav_level_mis_sigma {args.level_mis:g} arcsec, bias random walk "
           f"{args.bias_rw:g} deg/h/sqrt(h)")
     after = t >= 3600.0
     if np.any(after):
         rms = np.sqrt(np.mean(np.square(np.array(errs)[:, after]))) / ARCMIN_TO_RAD
         print(f"heading error RMS over the runs after the first hour: {rms:.3f}'")
+        hrms = np.sqrt(np.mean(np.square(np.array(herrs)[:, after])))
+        print(f"horizontal position error RMS over the runs after the first hour: {hrms:.2f} m")
     for name, v, (lo, hi) in (("heading", head, b1), ("horizontal", hor, b2)):
         inside = np.mean((v[late] >= lo) & (v[late] <= hi))
         print(f"{name:10s} mean NEES over the runs: time average {v[late].mean():.3f} (bounds {lo:.3f} .. "

@@ -24,7 +24,7 @@
 #define BENCH_TICKS 3000
 #endif
 
-static unsigned char g_mem[16384] __attribute__((aligned(16)));
+static unsigned char g_mem[20480] __attribute__((aligned(16)));
 
 int main(void) {
     pyins_config cfg;

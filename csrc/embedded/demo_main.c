@@ -13,7 +13,7 @@
 #include "demo_scenario.h"
 #include "pyins_core.h"
 
-static unsigned char g_mem[16384] __attribute__((aligned(16)));
+static unsigned char g_mem[20480] __attribute__((aligned(16)));
 
 static void put_hex(double x) {
     uint64_t u;

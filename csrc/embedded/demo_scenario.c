@@ -47,12 +47,15 @@ void demo_config(pyins_config *cfg) {
     cfg->gnss_lever_b_m[0] = 0.5;
     cfg->gnss_lever_b_m[1] = 2.0;
     cfg->gnss_lever_b_m[2] = 12.5;
-    /* the navigation filter told a bias random walk and the table's scale
-       factor and misalignment (2^-34 rad/s/sqrt(s), 2^-16, 2^-14 rad: exact
-       binary fractions near 0.0007 deg/h/sqrt(h), 15 ppm, 12.6 arcsec) */
+    /* the navigation filter told a bias random walk and the gyros' scale
+       factors and misalignments, on the table's axis and between the level
+       gyros (2^-34 rad/s/sqrt(s), 2^-16, 2^-14 rad: exact binary fractions
+       near 0.0007 deg/h/sqrt(h), 15 ppm, 12.6 arcsec) */
     cfg->nav_gyro_bias_rw = 5.820766091346741e-11;
     cfg->nav_table_scale_sigma = 1.52587890625e-05;
     cfg->nav_table_mis_sigma = 6.103515625e-05;
+    cfg->nav_level_scale_sigma = 1.52587890625e-05;
+    cfg->nav_level_mis_sigma = 6.103515625e-05;
 }
 
 int demo_fault(uint32_t k) {

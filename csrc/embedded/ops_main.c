@@ -28,7 +28,7 @@
 #define OP_REPEAT 1000
 #define NAV_TICKS 3000
 
-static unsigned char g_mem[16384] __attribute__((aligned(16)));
+static unsigned char g_mem[20480] __attribute__((aligned(16)));
 static volatile int g_counting;
 
 /* libgcc's routines take and return doubles in core registers (base AAPCS)

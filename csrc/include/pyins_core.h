@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 18
+#define PYINS_ABI_VERSION_MINOR 19
 
 #ifdef __cplusplus
 extern "C" {
@@ -371,15 +371,23 @@ typedef struct pyins_config {
                                      antenna's position and velocity by its own attitude and rates;
                                      0 = fixes of the reference point; |r| <= 100 m (else
                                      PYINS_E_CONFIG_LEVER) */
-    /* The navigation filter's model of the IMU beyond its bias states (ABI 0.18; docs/concepts.md,
-     * "At sea", the filter's consistency). Each 0 = not modelled (0 is 0 here, not a default);
-     * finite, >= 0 and within the bound given (else PYINS_E_CONFIG_NAV). */
+    /* The navigation filter's model of the IMU beyond its bias states (ABI 0.18, the table's errors
+     * as states since 0.19; docs/concepts.md, "At sea", the filter's consistency). Each 0 = not
+     * modelled (0 is 0 here, not a default); finite, >= 0 and within the bound given (else
+     * PYINS_E_CONFIG_NAV). */
     double nav_gyro_bias_rw;      /* the gyro biases' random walk, their instability [rad/s/sqrt(s)];
                                      <= 1e-6 (0.2 deg/h/sqrt(s)) */
-    double nav_table_scale_sigma; /* sigma of the scale factor of the gyro on the table's axis [-]: a
-                                     heading error of that fraction of every table move; <= 0.01 */
-    double nav_table_mis_sigma;   /* sigma of the other two gyros' misalignment to the table's axis
-                                     [rad]: a tilt of at most that fraction of a move; <= 0.01 rad */
+    double nav_table_scale_sigma; /* prior sigma of the scale factor of the gyro on the table's axis
+                                     [-], a state of the filter (a table move by a turns the heading
+                                     by that fraction of a); <= 0.01 */
+    double nav_table_mis_sigma;   /* prior sigma of the other two gyros' misalignments to the table's
+                                     axis [rad], two states (a tilt of that fraction of a move);
+                                     <= 0.01 rad */
+    double nav_level_scale_sigma; /* prior sigma of the x and y gyros' scale factors [-], two states
+                                     (with the misalignments below, the Earth's rate through them is
+                                     a heading error no indexing removes); <= 0.01 */
+    double nav_level_mis_sigma;   /* prior sigma of the x and y gyros' misalignments to each other
+                                     [rad], two states; <= 0.01 rad */
 } pyins_config;
 
 /* One IMU sample: what the IMU delivers for one tick [t_{k-1}, t_k]. */
@@ -464,6 +472,12 @@ typedef struct pyins_output {
     double nav_gyro_bias_rad_s[3]; /* gyro biases estimated and compensated, in p [rad/s] */
     double nav_accel_bias_mps2[3]; /* accelerometer biases estimated and compensated, in p (z: not
                                      estimated, 0) [m/s^2] */
+    double nav_table_err[3];      /* the table-axis errors estimated and compensated (ABI 0.19): the x
+                                     and y gyros' misalignments to the table's axis m_xz, m_yz [rad]
+                                     and the z gyro's scale factor k_z [-]; 0 while not modelled */
+    double nav_level_err[4];      /* the level gyros' errors estimated and compensated (ABI 0.19): the
+                                     scale factors k_x, k_y [-] and the misalignments m_xy (x's to
+                                     the y rate), m_yx [rad]; 0 while not modelled */
 } pyins_output;
 
 /* What the turntable's motor controller reads after every step, without
@@ -481,7 +495,7 @@ typedef struct pyins_motor_command {
  * the same names, bit for bit, without the Euler angles, the heading, the
  * alignment filter's state and the counters, whose derivation costs as much
  * as the navigation tick (pyins_run_nav, pyins_get_nav). 168 bytes against
- * pyins_output's 640. */
+ * pyins_output's 696. */
 typedef struct pyins_nav {
     int64_t tick;                 /* = pyins_output.tick */
     int32_t mode;                 /* = pyins_output.mode (enum pyins_mode) */

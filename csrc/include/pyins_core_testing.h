@@ -101,21 +101,22 @@ typedef struct pyins_t_nav_params {
     double gyro_arw, accel_vrw, gate;
     double sigma0_att[3];
     double sigma0_vel, sigma0_pos, sigma0_gyro, sigma0_accel;
-    double gyro_bias_rw, table_scale, table_mis;
+    double gyro_bias_rw, table_scale, table_mis, level_scale, level_mis;
 } pyins_t_nav_params;
 
 /* nav_filter::system_matrix: motion = [sin_lat, cos_lat, rm_h, rn_h, vel_e, vel_n],
- * c_np row-major; writes F (144, row-major) */
+ * c_np row-major, w_p the mean rate in p; writes F's 7 dynamic rows (7 x 19, row-major) */
 void pyins_t_nav_system_matrix(const double motion[6], const double f_n[3], const double c_np[9],
-                               double f_out[144]);
+                               const double w_p[3], double f_out[133]);
 /* nav_filter over n ticks from c_np0: each tick gathers dv_sf_n (n x 3) with
- * the table's turn dalpha (n) and predicts when `every` ticks are in, at motion (n x 6) and c_np (n x 9);
+ * the angle increment dtheta_p (n x 3) and predicts when `every` ticks are in, at motion (n x 6) and c_np (n x 9);
  * a tick with kind[k] (1: position rows, 2: velocity rows; 0: none)
  * predicts up to it, takes the NIS of z, r (n x 2 each) into nis[k] and,
- * within the gate, updates and resets the feedback. Writes x (12), P (144),
- * the biases (3 + 3); returns the number of updates. */
+ * within the gate, updates and resets the feedback. Writes x (19), P (361),
+ * the compensations: gyro biases, accelerometer biases, table-axis errors,
+ * level gyro errors (3 + 3 + 3 + 4); returns the number of updates. */
 int pyins_t_nav_filter_run(const pyins_t_nav_params *p, const double c_np0[9], const double *dv_sf_n,
-                           const double *dalpha, const double *motion, const double *c_np, const int32_t *kind,
+                           const double *dtheta_p, const double *motion, const double *c_np, const int32_t *kind,
                            const double *z, const double *r, size_t n, double *nis, double *x_out,
                            double *p_out, double *bias_out);
 

@@ -296,17 +296,18 @@ pyins::nav_filter::Motion nav_motion6(const double* m) {
 }  // namespace
 
 void pyins_t_nav_system_matrix(const double motion[6], const double f_n[3], const double c_np[9],
-                               double f_out[144]) {
-    const auto f = pyins::nav_filter::system_matrix(nav_motion6(motion), v3(f_n), m9(c_np));
-    for (int i = 0; i < 12; ++i) {
-        for (int j = 0; j < 12; ++j) {
-            f_out[12 * i + j] = f(i, j);
+                               const double w_p[3], double f_out[133]) {
+    namespace nf = pyins::nav_filter;
+    const auto f = nf::system_matrix(nav_motion6(motion), v3(f_n), m9(c_np), v3(w_p));
+    for (int i = 0; i < nf::kDyn; ++i) {
+        for (int j = 0; j < nf::kStates; ++j) {
+            f_out[nf::kStates * i + j] = f(i, j);
         }
     }
 }
 
 int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], const double* dv_sf_n,
-                           const double* dalpha, const double* motion, const double* c_np, const int32_t* kind,
+                           const double* dtheta_p, const double* motion, const double* c_np, const int32_t* kind,
                            const double* z, const double* r, size_t n, double* nis, double* x_out,
                            double* p_out, double* bias_out) {
     namespace nf = pyins::nav_filter;
@@ -327,13 +328,15 @@ int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], c
     prm.gyro_bias_rw = p->gyro_bias_rw;
     prm.table_scale = p->table_scale;
     prm.table_mis = p->table_mis;
+    prm.level_scale = p->level_scale;
+    prm.level_mis = p->level_mis;
     nf::NavFilter f;
     nf::init(f, prm, m9(c_np0));
     int updates = 0;
     for (size_t k = 0; k < n; ++k) {
         const nf::Motion mo = nav_motion6(motion + 6 * k);
         const Mat3 c = m9(c_np + 9 * k);
-        nf::gather(f, v3(dv_sf_n + 3 * k), dalpha[k]);
+        nf::gather(f, v3(dv_sf_n + 3 * k), v3(dtheta_p + 3 * k));
         if (f.ticks == f.prm.every) {
             nf::predict(f, mo, c);
         }
@@ -350,15 +353,19 @@ int pyins_t_nav_filter_run(const pyins_t_nav_params* p, const double c_np0[9], c
             }
         }
     }
-    for (int i = 0; i < 12; ++i) {
+    for (int i = 0; i < nf::kStates; ++i) {
         x_out[i] = f.x(i);
-        for (int j = 0; j < 12; ++j) {
-            p_out[12 * i + j] = f.p(i, j);
+        for (int j = 0; j < nf::kStates; ++j) {
+            p_out[nf::kStates * i + j] = f.p(i, j);
         }
     }
     for (int i = 0; i < 3; ++i) {
         bias_out[i] = f.gyro_bias(i);
         bias_out[3 + i] = f.accel_bias(i);
+        bias_out[6 + i] = f.table_err(i);
+    }
+    for (int i = 0; i < 4; ++i) {
+        bias_out[9 + i] = f.level_err[i];
     }
     return updates;
 }

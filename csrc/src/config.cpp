@@ -289,9 +289,11 @@ int config_check(const pyins_config& raw) {
     }
     // the filter's model beyond its bias states: 0 (not modelled) or a
     // finite value within the bound (pyins_core.h)
-    const double model[3] = {cfg.nav_gyro_bias_rw, cfg.nav_table_scale_sigma, cfg.nav_table_mis_sigma};
-    const double bound[3] = {kMaxNavGyroBiasRw, kMaxNavTableSigma, kMaxNavTableSigma};
-    for (int i = 0; i < 3; ++i) {
+    const double model[5] = {cfg.nav_gyro_bias_rw, cfg.nav_table_scale_sigma, cfg.nav_table_mis_sigma,
+                             cfg.nav_level_scale_sigma, cfg.nav_level_mis_sigma};
+    const double bound[5] = {kMaxNavGyroBiasRw, kMaxNavTableSigma, kMaxNavTableSigma, kMaxNavTableSigma,
+                             kMaxNavTableSigma};
+    for (int i = 0; i < 5; ++i) {
         if (!(model[i] >= 0.0) || !(model[i] <= bound[i])) {
             return PYINS_E_CONFIG_NAV;
         }

@@ -787,10 +787,11 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
         fine_tick(dtheta_p, dv_p);
     } else {
         if (nav_on_ != 0) {
-            // the biases the filter estimated, compensated (0 until it has)
-            const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_p - nav_.gyro_bias * dt_,
-                                                   dv_p - nav_.accel_bias * dt_, dt_);
-            nav_tick(dv_sf_n, dalpha);
+            // the biases and table-axis errors the filter estimated,
+            // compensated (0 until it has)
+            const Vec3 dtheta_c = nav_filter::compensate_gyro(nav_, dtheta_p, dt_);
+            const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_c, dv_p - nav_.accel_bias * dt_, dt_);
+            nav_tick(dv_sf_n, dtheta_c);
             blend_tick();
         } else {
             strapdown::update(sd_, dtheta_p, dv_p, dt_);
@@ -963,8 +964,12 @@ void Firmware::output(pyins_output* out) const {
                                                 nav_.p(nav_filter::kPos + 1, nav_filter::kPos + 1) + off2)
                                   : 0.0;
     out->nav_sigma_heading_rad = filter ? pmath::sqrt(nav_.p(nav_filter::kPhi + 2, nav_filter::kPhi + 2)) : 0.0;
+    for (int i = 0; i < 4; ++i) {
+        out->nav_level_err[i] = filter ? nav_.level_err[i] : 0.0;
+    }
     for (int i = 0; i < 3; ++i) {
         out->nav_gyro_bias_rad_s[i] = filter ? nav_.gyro_bias(i) : 0.0;
+        out->nav_table_err[i] = filter ? nav_.table_err(i) : 0.0;
         out->nav_accel_bias_mps2[i] = filter ? nav_.accel_bias(i) : 0.0;
     }
 }

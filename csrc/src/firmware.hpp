@@ -256,7 +256,7 @@ class Firmware {
     /// The filter's linearisation point now.
     nav_filter::Motion nav_motion() const;
     /// Navigation filter work of a NAVIGATE tick, after the strapdown.
-    void nav_tick(const Vec3& dv_sf_n, double dalpha);
+    void nav_tick(const Vec3& dv_sf_n, const Vec3& dtheta_c);
     /// The output offset's decay, once a tick in NAVIGATE (kBlendTau).
     void blend_tick();
     /// The output offset's position part in metres (E, N), by the Earth's

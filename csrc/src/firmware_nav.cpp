@@ -73,6 +73,8 @@ void Firmware::start_nav_filter() {
     prm.gyro_bias_rw = cfg_.nav_gyro_bias_rw;
     prm.table_scale = cfg_.nav_table_scale_sigma;
     prm.table_mis = cfg_.nav_table_mis_sigma;
+    prm.level_scale = cfg_.nav_level_scale_sigma;
+    prm.level_mis = cfg_.nav_level_mis_sigma;
     nav_filter::init(nav_, prm, attitude::quat_to_mat(sd_.nav.quat_np));
     nav_on_ = 1;
     for (int i = 0; i < 4; ++i) {
@@ -95,8 +97,8 @@ nav_filter::Motion Firmware::nav_motion() const {
     return m;
 }
 
-void Firmware::nav_tick(const Vec3& dv_sf_n, double dalpha) {
-    nav_filter::gather(nav_, dv_sf_n, dalpha);
+void Firmware::nav_tick(const Vec3& dv_sf_n, const Vec3& dtheta_c) {
+    nav_filter::gather(nav_, dv_sf_n, dtheta_c);
     if (nav_.ticks == nav_.prm.every) {
         nav_filter::predict(nav_, nav_motion(), attitude::quat_to_mat(sd_.nav.quat_np));
         if (nav_.healthy == 0) {

@@ -1,16 +1,22 @@
 // nav_filter.cpp: see nav_filter.hpp. Mirrored by pyins/reference/nav_filter.py.
 #include "nav_filter.hpp"
 
+#include <cmath>
+
 #include "earth.hpp"
 
 namespace pyins::nav_filter {
 
-using M12 = kalman::Mat<kStates, kStates>;
+using MS = kalman::Mat<kStates, kStates>;
+using MF = kalman::Mat<kDyn, kStates>;
+constexpr int kCon = kStates - kDyn;   ///< the constants: eps, nabla, the scale factors and misalignments
+using MD = kalman::Mat<kDyn, kDyn>;
+using MDC = kalman::Mat<kDyn, kCon>;
 
 namespace {
 
 /// P symmetrised from its two triangles.
-void symmetrise(M12& p) {
+void symmetrise(MS& p) {
     for (int i = 0; i < kStates; ++i) {
         for (int j = i + 1; j < kStates; ++j) {
             const double s = 0.5 * (p(i, j) + p(j, i));
@@ -18,6 +24,19 @@ void symmetrise(M12& p) {
             p(j, i) = s;
         }
     }
+}
+
+/// P's diagonal positive and finite, the scale-factor and misalignment
+/// states' at least not negative (0 while they are not modelled).
+bool diagonal_healthy(const MS& p) {
+    for (int i = 0; i < kStates; ++i) {
+        const double d = p(i, i);
+        const bool ok = i < kTab ? d > 0.0 : d >= 0.0;
+        if (!ok || !std::isfinite(d)) {   // refuses NaN and Inf
+            return false;
+        }
+    }
+    return true;
 }
 
 }  // namespace
@@ -38,21 +57,31 @@ void init(NavFilter& f, const Params& prm, const Mat3& c_np) {
     sigma(kEps + 2) = prm.sigma0_gyro;
     sigma(kNabla + 0) = prm.sigma0_accel;
     sigma(kNabla + 1) = prm.sigma0_accel;
-    f.p = M12::Zero();
+    sigma(kTab + 0) = prm.table_mis;
+    sigma(kTab + 1) = prm.table_mis;
+    sigma(kTab + 2) = prm.table_scale;
+    sigma(kLev + 0) = prm.level_scale;
+    sigma(kLev + 1) = prm.level_scale;
+    sigma(kLev + 2) = prm.level_mis;
+    sigma(kLev + 3) = prm.level_mis;
+    f.p = MS::Zero();
     for (int i = 0; i < kStates; ++i) {
         f.p(i, i) = sigma(i) * sigma(i);
     }
     f.dv_sum = Vec3::Zero();
     f.c_start = c_np;
     f.ticks = 0;
-    f.move_angle = 0.0;
-    f.move_q = 0.0;
+    f.dtheta_sum = Vec3::Zero();
     f.healthy = 1;
     f.gyro_bias = Vec3::Zero();
     f.accel_bias = Vec3::Zero();
+    f.table_err = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) {
+        f.level_err[i] = 0.0;
+    }
 }
 
-M12 system_matrix(const Motion& m, const Vec3& f_n, const Mat3& c_np) {
+MF system_matrix(const Motion& m, const Vec3& f_n, const Mat3& c_np, const Vec3& w_p) {
     const double w = earth::kOmegaIe;
     const double tan_lat = m.sin_lat / m.cos_lat;
     const double sec2 = 1.0 / (m.cos_lat * m.cos_lat);
@@ -62,7 +91,7 @@ M12 system_matrix(const Motion& m, const Vec3& f_n, const Mat3& c_np) {
     const double w_u = w * m.sin_lat + m.vel_e * tan_lat / m.rn_h;
     // 2 w_ie + w_en, up component (the horizontal rows of its cross product with dv)
     const double w2_u = 2.0 * w * m.sin_lat + m.vel_e * tan_lat / m.rn_h;
-    M12 f = M12::Zero();
+    MF f = MF::Zero();
     // phi' = -w_in x phi + dw_in - C eps
     f(kPhi + 0, kPhi + 1) = w_u;
     f(kPhi + 0, kPhi + 2) = -w_n;
@@ -79,6 +108,19 @@ M12 system_matrix(const Motion& m, const Vec3& f_n, const Mat3& c_np) {
         for (int j = 0; j < 3; ++j) {
             f(kPhi + i, kEps + j) = -c_np(i, j);
         }
+    }
+    // ... - C [m_xz m_yz k_z]^T w_z: the table-axis errors act as biases of w_z times themselves
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            f(kPhi + i, kTab + j) = -c_np(i, j) * w_p(2);
+        }
+    }
+    // ... - C(:,0) (k_x w_x + m_xy w_y) - C(:,1) (m_yx w_x + k_y w_y)
+    for (int i = 0; i < 3; ++i) {
+        f(kPhi + i, kLev + 0) = -c_np(i, 0) * w_p(0);
+        f(kPhi + i, kLev + 1) = -c_np(i, 1) * w_p(1);
+        f(kPhi + i, kLev + 2) = -c_np(i, 0) * w_p(1);
+        f(kPhi + i, kLev + 3) = -c_np(i, 1) * w_p(0);
     }
     // dv' = f x phi - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) + C nabla
     f(kVel + 0, kPhi + 1) = -f_n(2);
@@ -110,19 +152,40 @@ void predict(NavFilter& f, const Motion& m, const Mat3& c_np) {
     }
     const double span = static_cast<double>(f.ticks) * f.prm.dt;
     const Mat3 c_mean = 0.5 * (f.c_start + c_np);
-    // coefficient-based products (lazyProduct): moving_align.cpp says why
-    const M12 ft = system_matrix(m, f.dv_sum / span, c_mean) * span;
-    M12 phi = ft + 0.5 * ft.lazyProduct(ft);
-    for (int i = 0; i < kStates; ++i) {
-        phi(i, i) = phi(i, i) + 1.0;
+    // Phi = I + F T + (F T)^2 / 2 by blocks: F T = [A_d A_c; 0 0], so
+    // (F T)^2 = [A_d A_d, A_d A_c; 0 0] (coefficient-based products,
+    // lazyProduct: moving_align.cpp says why)
+    // (each temporary in its own scope: the frame holds the largest pair,
+    // not their sum)
+    MD phi_d;
+    MDC phi_c;
+    {
+        MF ft = system_matrix(m, f.dv_sum / span, c_mean, f.dtheta_sum / span);
+        ft = ft * span;
+        phi_d = ft.leftCols<kDyn>() + 0.5 * ft.leftCols<kDyn>().lazyProduct(ft.leftCols<kDyn>());
+        phi_c = ft.rightCols<kCon>() + 0.5 * ft.leftCols<kDyn>().lazyProduct(ft.rightCols<kCon>());
+    }
+    for (int i = 0; i < kDyn; ++i) {
+        phi_d(i, i) = phi_d(i, i) + 1.0;
     }
     {
-        const kalman::Vec<kStates> xp = phi.lazyProduct(f.x);
-        f.x = xp;
+        const kalman::Vec<kDyn> xd = phi_d.lazyProduct(f.x.head<kDyn>()) + phi_c.lazyProduct(f.x.tail<kCon>());
+        f.x.head<kDyn>() = xd;
     }
     {
-        const M12 ap = phi.lazyProduct(f.p);
-        f.p = ap.lazyProduct(phi.transpose());
+        // P = [P_dd P_dc; P_cd P_cc]:
+        //   P_dc' = Phi_d P_dc + Phi_c P_cc
+        //   P_dd' = (Phi_d P_dd + Phi_c P_cd) Phi_d^T + P_dc' Phi_c^T
+        //   P_cc' = P_cc
+        // (the blocks read in place: no copy of P on the stack)
+        const MD t = phi_d.lazyProduct(f.p.topLeftCorner<kDyn, kDyn>()) +
+                     phi_c.lazyProduct(f.p.bottomLeftCorner<kCon, kDyn>());
+        const MDC n_dc = phi_d.lazyProduct(f.p.topRightCorner<kDyn, kCon>()) +
+                         phi_c.lazyProduct(f.p.bottomRightCorner<kCon, kCon>());
+        f.p.topLeftCorner<kDyn, kDyn>().noalias() =
+            t.lazyProduct(phi_d.transpose()) + n_dc.lazyProduct(phi_c.transpose());
+        f.p.topRightCorner<kDyn, kCon>() = n_dc;
+        f.p.bottomLeftCorner<kCon, kDyn>() = n_dc.transpose();
     }
     const double q_att = f.prm.gyro_arw * f.prm.gyro_arw * span;
     const double q_vel = f.prm.accel_vrw * f.prm.accel_vrw * span;
@@ -137,19 +200,12 @@ void predict(NavFilter& f, const Motion& m, const Mat3& c_np) {
         f.p(kEps + 1, kEps + 1) = f.p(kEps + 1, kEps + 1) + q_eps;
         f.p(kEps + 2, kEps + 2) = f.p(kEps + 2, kEps + 2) + q_eps;
     }
-    if (f.move_q > 0.0) {
-        const double q_tilt = f.prm.table_mis * f.prm.table_mis * f.move_q;
-        const double q_head = f.prm.table_scale * f.prm.table_scale * f.move_q;
-        f.p(kPhi + 0, kPhi + 0) = f.p(kPhi + 0, kPhi + 0) + q_tilt;
-        f.p(kPhi + 1, kPhi + 1) = f.p(kPhi + 1, kPhi + 1) + q_tilt;
-        f.p(kPhi + 2, kPhi + 2) = f.p(kPhi + 2, kPhi + 2) + q_head;
-    }
-    f.move_q = 0.0;
     symmetrise(f.p);
     f.dv_sum = Vec3::Zero();
+    f.dtheta_sum = Vec3::Zero();
     f.c_start = c_np;
     f.ticks = 0;
-    if (!kalman::diagonal_positive<kStates>(f.p)) {
+    if (!diagonal_healthy(f.p)) {
         f.healthy = 0;
     }
 }
@@ -171,23 +227,26 @@ void update_pair(NavFilter& f, int k0, const double z[2], const double r[2]) {
         const int k = k0 + c;
         const double s = f.p(k, k) + r[c];
         const double nu = z[c] - f.x(k);
-        const kalman::Vec<kStates> gain = f.p.col(k) / s;
+        const kalman::Vec<kStates> pk = f.p.col(k);   // = row k (P symmetric)
+        const kalman::Vec<kStates> gain = pk / s;
         f.x = f.x + gain * nu;
-        M12 a = f.p;
+        // P' = A - A(:,k) K^T + r K K^T with A = P - K P(k,:), in place
+        // from the saved column: A(i,j) = P(i,j) - K_i P(k,j), A(i,k) =
+        // P(i,k) - K_i P(k,k)
+        // The upper triangle, mirrored into the lower (the result is
+        // symmetric: half the work of the whole and of symmetrising it).
+        const double pkk = pk(k);
         for (int i = 0; i < kStates; ++i) {
-            for (int j = 0; j < kStates; ++j) {
-                a(i, j) = a(i, j) - gain(i) * f.p(k, j);
+            const double aik = pk(i) - gain(i) * pkk;
+            for (int j = i; j < kStates; ++j) {
+                const double aij = f.p(i, j) - gain(i) * pk(j);
+                const double v = aij - aik * gain(j) + r[c] * gain(i) * gain(j);
+                f.p(i, j) = v;
+                f.p(j, i) = v;
             }
         }
-        for (int i = 0; i < kStates; ++i) {
-            const double aik = a(i, k);
-            for (int j = 0; j < kStates; ++j) {
-                f.p(i, j) = a(i, j) - aik * gain(j) + r[c] * gain(i) * gain(j);
-            }
-        }
-        symmetrise(f.p);
     }
-    if (!kalman::diagonal_positive<kStates>(f.p)) {
+    if (!diagonal_healthy(f.p)) {
         f.healthy = 0;
     }
 }
@@ -198,6 +257,12 @@ void reset_feedback(NavFilter& f) {
     f.gyro_bias(2) = f.gyro_bias(2) + f.x(kEps + 2);
     f.accel_bias(0) = f.accel_bias(0) + f.x(kNabla + 0);
     f.accel_bias(1) = f.accel_bias(1) + f.x(kNabla + 1);
+    f.table_err(0) = f.table_err(0) + f.x(kTab + 0);
+    f.table_err(1) = f.table_err(1) + f.x(kTab + 1);
+    f.table_err(2) = f.table_err(2) + f.x(kTab + 2);
+    for (int i = 0; i < 4; ++i) {
+        f.level_err[i] = f.level_err[i] + f.x(kLev + i);
+    }
     f.x = kalman::Vec<kStates>::Zero();
 }
 

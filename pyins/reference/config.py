@@ -132,6 +132,8 @@ def config_default():
         "nav_gyro_bias_rw": 0.0,
         "nav_table_scale_sigma": 0.0,
         "nav_table_mis_sigma": 0.0,
+        "nav_level_scale_sigma": 0.0,
+        "nav_level_mis_sigma": 0.0,
     }
 
 
@@ -330,9 +332,11 @@ def config_check(raw):
         return abi.PYINS_E_CONFIG_NAV
     # the filter's model beyond its bias states: 0 (not modelled) or a
     # finite value within the bound (pyins_core.h)
-    model = (cfg["nav_gyro_bias_rw"], cfg["nav_table_scale_sigma"], cfg["nav_table_mis_sigma"])
-    bound = (MAX_NAV_GYRO_BIAS_RW, MAX_NAV_TABLE_SIGMA, MAX_NAV_TABLE_SIGMA)
-    for i in range(3):
+    model = (cfg["nav_gyro_bias_rw"], cfg["nav_table_scale_sigma"], cfg["nav_table_mis_sigma"],
+             cfg["nav_level_scale_sigma"], cfg["nav_level_mis_sigma"])
+    bound = (MAX_NAV_GYRO_BIAS_RW, MAX_NAV_TABLE_SIGMA, MAX_NAV_TABLE_SIGMA, MAX_NAV_TABLE_SIGMA,
+             MAX_NAV_TABLE_SIGMA)
+    for i in range(5):
         if not (model[i] >= 0.0) or not (model[i] <= bound[i]):
             return abi.PYINS_E_CONFIG_NAV
     return abi.PYINS_OK

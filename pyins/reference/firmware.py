@@ -17,7 +17,8 @@ import numpy as np
 
 from pyins.units import ARCMIN_TO_RAD
 
-from . import abi, attitude, coarse_align, config, earth, fine_align, indexing, moving_align, strapdown
+from . import (abi, attitude, coarse_align, config, earth, fine_align, indexing, moving_align, nav_filter,
+               strapdown)
 from .angle import wrap_pi, wrap_two_pi
 from .attitude import cross
 from .config import finite3
@@ -577,10 +578,11 @@ class Firmware(NavAtSea):
                 self.end_fine()
         else:
             if self.nav_on:
-                # the biases the filter estimated, compensated (0 until it has)
-                dv_sf_n = strapdown.update(self.sd, dtheta_p - self.nav.gyro_bias * self.dt,
-                                           dv_p - self.nav.accel_bias * self.dt, self.dt)
-                self.nav_tick(dv_sf_n, dalpha)
+                # the biases and table-axis errors the filter estimated,
+                # compensated (0 until it has)
+                dtheta_c = nav_filter.compensate_gyro(self.nav, dtheta_p, self.dt)
+                dv_sf_n = strapdown.update(self.sd, dtheta_c, dv_p - self.nav.accel_bias * self.dt, self.dt)
+                self.nav_tick(dv_sf_n, dtheta_c)
                 self.blend_tick()
             else:
                 strapdown.update(self.sd, dtheta_p, dv_p, self.dt)

@@ -104,7 +104,8 @@ class NavAtSea:
             sigma0_att=att, sigma0_vel=config.NAV_SIGMA0_VEL, sigma0_pos=config.NAV_SIGMA0_POS,
             sigma0_gyro=cfg["fine_sigma0_gyro"], sigma0_accel=cfg["fine_sigma0_accel"],
             gyro_bias_rw=cfg["nav_gyro_bias_rw"], table_scale=cfg["nav_table_scale_sigma"],
-            table_mis=cfg["nav_table_mis_sigma"])
+            table_mis=cfg["nav_table_mis_sigma"], level_scale=cfg["nav_level_scale_sigma"],
+            level_mis=cfg["nav_level_mis_sigma"])
         self.nav = nav_filter.init(prm, attitude.quat_to_mat(self.sd.nav.quat_np))
         self.nav_on = 1
         self.out_off = [0.0, 0.0, 0.0, 0.0]
@@ -119,8 +120,8 @@ class NavAtSea:
         return nav_filter.Motion(sin_lat, cos_lat, rm + nav.height, rn + nav.height,
                                  float(nav.vel_n[0]), float(nav.vel_n[1]))
 
-    def nav_tick(self, dv_sf_n, dalpha):
-        nav_filter.gather(self.nav, dv_sf_n, dalpha)
+    def nav_tick(self, dv_sf_n, dtheta_c):
+        nav_filter.gather(self.nav, dv_sf_n, dtheta_c)
         if self.nav.ticks == self.nav.prm.every:
             nav_filter.predict(self.nav, self.nav_motion(), attitude.quat_to_mat(self.sd.nav.quat_np))
             if self.nav.healthy == 0:
@@ -505,5 +506,7 @@ class NavAtSea:
                                          + p[nav_filter.POS + 1, nav_filter.POS + 1] + off2) if on else 0.0,
             "nav_sigma_heading_rad": math.sqrt(p[nav_filter.PHI + 2, nav_filter.PHI + 2]) if on else 0.0,
             "nav_gyro_bias_rad_s": self.nav.gyro_bias.copy() if on else np.zeros(3),
+            "nav_table_err": self.nav.table_err.copy() if on else np.zeros(3),
+            "nav_level_err": self.nav.level_err.copy() if on else np.zeros(4),
             "nav_accel_bias_mps2": self.nav.accel_bias.copy() if on else np.zeros(3),
         }

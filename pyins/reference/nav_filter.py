@@ -1,23 +1,28 @@
 """The integrated navigation filter at sea: an error-state Kalman filter run
-beside the strapdown in NAVIGATE, 12 states, for the IMU frame p.
+beside the strapdown in NAVIGATE, 19 states, for the IMU frame p.
 
 Mirrors ``csrc/src/nav_filter.{hpp,cpp}``; the header gives the model
-(X = [phi, dv_E, dv_N, dp_E, dp_N, eps_p, nabla_x, nabla_y], Yan 2019 eqs.
-4.2.26-4.2.33 with the ship's velocity), the gate (the joint NIS of a pair,
+(X = [phi, dv_E, dv_N, dp_E, dp_N, eps_p, nabla_x, nabla_y, m_xz, m_yz, k_z,
+k_x, k_y, m_xy, m_yx], Yan 2019 eqs. 4.2.26-4.2.33 with the ship's velocity;
+the gyros' scale factors and misalignments act through the rates), the time update by blocks (the
+constants' rows of F are zero), the gate (the joint NIS of a pair,
 chi-square with 2 degrees of freedom) and the feedback.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import earth, kalman
+from . import earth
 
-STATES = 12     #: kStates
+STATES = 19     #: kStates
+DYN = 7         #: kDyn: phi, dv, dp; the rest are constants
 PHI = 0         #: kPhi
 VEL = 3         #: kVel
 POS = 5         #: kPos
 EPS = 7         #: kEps (p)
 NABLA = 10      #: kNabla (p, x and y)
+TAB = 12        #: kTab: m_xz, m_yz, k_z (p)
+LEV = 15        #: kLev: k_x, k_y, m_xy, m_yx (p)
 
 
 @dataclass
@@ -34,8 +39,10 @@ class Params:
     sigma0_gyro: float
     sigma0_accel: float
     gyro_bias_rw: float = 0.0   #: the biases' random walk [rad/s/sqrt(s)]; 0 = constants
-    table_scale: float = 0.0    #: sigma of the table-axis gyro's scale factor; 0 = none
-    table_mis: float = 0.0      #: sigma of the other gyros' misalignment to the table's axis [rad]
+    table_scale: float = 0.0    #: prior sigma of k_z, the table-axis gyro's scale factor; 0 = not modelled
+    table_mis: float = 0.0      #: prior sigma of m_xz, m_yz [rad]; 0 = not modelled
+    level_scale: float = 0.0    #: prior sigma of k_x, k_y; 0 = not modelled
+    level_mis: float = 0.0      #: prior sigma of m_xy, m_yx [rad]; 0 = not modelled
 
 
 @dataclass
@@ -58,10 +65,11 @@ class NavFilter:
     c_start: np.ndarray = field(default_factory=lambda: np.eye(3))
     ticks: int = 0
     healthy: int = 1
-    move_angle: float = 0.0
-    move_q: float = 0.0
+    dtheta_sum: np.ndarray = field(default_factory=lambda: np.zeros(3))
     gyro_bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
     accel_bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    table_err: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    level_err: np.ndarray = field(default_factory=lambda: np.zeros(4))
 
 
 def init(prm, c_np):
@@ -69,26 +77,40 @@ def init(prm, c_np):
     s = prm.sigma0_att
     sigma = np.array([s[0], s[1], s[2], prm.sigma0_vel, prm.sigma0_vel, prm.sigma0_pos,
                       prm.sigma0_pos, prm.sigma0_gyro, prm.sigma0_gyro, prm.sigma0_gyro,
-                      prm.sigma0_accel, prm.sigma0_accel])
+                      prm.sigma0_accel, prm.sigma0_accel, prm.table_mis, prm.table_mis,
+                      prm.table_scale, prm.level_scale, prm.level_scale, prm.level_mis, prm.level_mis])
     return NavFilter(prm=prm, p=np.diag(sigma * sigma), c_start=np.array(c_np, dtype=float))
 
 
-def gather(f, dv_sf_n, dalpha):
-    """One tick's specific-force velocity increment in n' and the table's
-    turn dalpha: the move's angle and the growth of its square (mirrors
-    gather)."""
+def gather(f, dv_sf_n, dtheta_p):
+    """One tick's specific-force velocity increment in n' and its
+    compensated angle increment in p (mirrors gather)."""
     f.dv_sum = f.dv_sum + dv_sf_n
+    f.dtheta_sum = f.dtheta_sum + dtheta_p
     f.ticks = f.ticks + 1
-    if dalpha != 0.0:
-        # (a + da)^2 - a^2
-        f.move_q = f.move_q + (2.0 * f.move_angle + dalpha) * dalpha
-        f.move_angle = f.move_angle + dalpha
-    else:
-        f.move_angle = 0.0
 
 
-def system_matrix(m, f_n, c_np):
-    """Continuous-time F (mirrors system_matrix; the header gives the equations)."""
+def compensate_gyro(f, dtheta_p, dt):
+    """The gyro increment with the estimated biases, scale factors and
+    misalignments removed (mirrors compensate_gyro)."""
+    d = dtheta_p - f.gyro_bias * dt
+    lv = f.level_err
+    return np.array([d[0] - lv[0] * dtheta_p[0] - lv[2] * dtheta_p[1] - f.table_err[0] * dtheta_p[2],
+                     d[1] - lv[3] * dtheta_p[0] - lv[1] * dtheta_p[1] - f.table_err[1] * dtheta_p[2],
+                     d[2] - f.table_err[2] * dtheta_p[2]])
+
+
+def diagonal_healthy(p):
+    """P's diagonal positive and finite, the scale-factor and misalignment
+    states' not negative (0 while not modelled; mirrors the anonymous
+    diagonal_healthy)."""
+    d = np.diag(p)
+    return bool(np.all(d[:TAB] > 0.0) and np.all(d[TAB:] >= 0.0) and np.all(np.isfinite(d)))
+
+
+def system_matrix(m, f_n, c_np, w_p):
+    """The dynamic rows of the continuous-time F, 7 x 19, at the mean
+    rate w_p (mirrors system_matrix; the header gives the equations)."""
     w = earth.OMEGA_IE
     tan_lat = m.sin_lat / m.cos_lat
     sec2 = 1.0 / (m.cos_lat * m.cos_lat)
@@ -96,7 +118,7 @@ def system_matrix(m, f_n, c_np):
     w_n = w * m.cos_lat + m.vel_e / m.rn_h
     w_u = w * m.sin_lat + m.vel_e * tan_lat / m.rn_h
     w2_u = 2.0 * w * m.sin_lat + m.vel_e * tan_lat / m.rn_h
-    f = np.zeros((STATES, STATES))
+    f = np.zeros((DYN, STATES))
     # phi' = -w_in x phi + dw_in - C eps
     f[PHI + 0, PHI + 1] = w_u
     f[PHI + 0, PHI + 2] = -w_n
@@ -110,6 +132,14 @@ def system_matrix(m, f_n, c_np):
     f[PHI + 1, POS + 1] = -w * m.sin_lat / m.rm_h
     f[PHI + 2, POS + 1] = (w * m.cos_lat + m.vel_e * sec2 / m.rn_h) / m.rm_h
     f[PHI:PHI + 3, EPS:EPS + 3] = -np.asarray(c_np)
+    # ... - C [m_xz m_yz k_z]^T w_z
+    c = np.asarray(c_np)
+    f[PHI:PHI + 3, TAB:TAB + 3] = -c * w_p[2]
+    # ... - C(:,0) (k_x w_x + m_xy w_y) - C(:,1) (m_yx w_x + k_y w_y)
+    f[PHI:PHI + 3, LEV + 0] = -c[:, 0] * w_p[0]
+    f[PHI:PHI + 3, LEV + 1] = -c[:, 1] * w_p[1]
+    f[PHI:PHI + 3, LEV + 2] = -c[:, 0] * w_p[1]
+    f[PHI:PHI + 3, LEV + 3] = -c[:, 1] * w_p[0]
     # dv' = f x phi - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) + C nabla
     f[VEL + 0, PHI + 1] = -f_n[2]
     f[VEL + 0, PHI + 2] = f_n[1]
@@ -130,38 +160,43 @@ def system_matrix(m, f_n, c_np):
 
 
 def predict(f, m, c_np):
-    """Time update over the ticks gathered (mirrors predict)."""
+    """Time update over the ticks gathered, by blocks (mirrors predict)."""
     if f.ticks == 0:
         return
     span = float(f.ticks) * f.prm.dt
     c_mean = 0.5 * (f.c_start + c_np)
-    ft = system_matrix(m, f.dv_sum / span, c_mean) * span
-    phi = ft + 0.5 * (ft @ ft)
-    phi[np.diag_indices(STATES)] += 1.0
-    f.x = phi @ f.x
-    f.p = (phi @ f.p) @ phi.T
+    ft = system_matrix(m, f.dv_sum / span, c_mean, f.dtheta_sum / span) * span
+    a_d, a_c = ft[:, :DYN], ft[:, DYN:]
+    phi_d = a_d + 0.5 * (a_d @ a_d)
+    phi_d[np.diag_indices(DYN)] += 1.0
+    phi_c = a_c + 0.5 * (a_d @ a_c)
+    x = f.x.copy()
+    x[:DYN] = phi_d @ f.x[:DYN] + phi_c @ f.x[DYN:]
+    f.x = x
+    # P = [P_dd P_dc; P_cd P_cc] (the header gives the blocks)
+    t = phi_d @ f.p[:DYN, :DYN] + phi_c @ f.p[DYN:, :DYN]
+    n_dc = phi_d @ f.p[:DYN, DYN:] + phi_c @ f.p[DYN:, DYN:]
+    n_dd = t @ phi_d.T + n_dc @ phi_c.T
+    p = f.p.copy()
+    p[:DYN, :DYN] = n_dd
+    p[:DYN, DYN:] = n_dc
+    p[DYN:, :DYN] = n_dc.T
     q_att = f.prm.gyro_arw * f.prm.gyro_arw * span
     q_vel = f.prm.accel_vrw * f.prm.accel_vrw * span
     for i in range(3):
-        f.p[PHI + i, PHI + i] = f.p[PHI + i, PHI + i] + q_att
+        p[PHI + i, PHI + i] = p[PHI + i, PHI + i] + q_att
     for i in (VEL, VEL + 1):
-        f.p[i, i] = f.p[i, i] + q_vel
+        p[i, i] = p[i, i] + q_vel
     if f.prm.gyro_bias_rw > 0.0:
         q_eps = f.prm.gyro_bias_rw * f.prm.gyro_bias_rw * span
         for i in range(3):
-            f.p[EPS + i, EPS + i] = f.p[EPS + i, EPS + i] + q_eps
-    if f.move_q > 0.0:
-        q_tilt = f.prm.table_mis * f.prm.table_mis * f.move_q
-        q_head = f.prm.table_scale * f.prm.table_scale * f.move_q
-        f.p[PHI + 0, PHI + 0] = f.p[PHI + 0, PHI + 0] + q_tilt
-        f.p[PHI + 1, PHI + 1] = f.p[PHI + 1, PHI + 1] + q_tilt
-        f.p[PHI + 2, PHI + 2] = f.p[PHI + 2, PHI + 2] + q_head
-    f.move_q = 0.0
-    f.p = 0.5 * (f.p + f.p.T)
+            p[EPS + i, EPS + i] = p[EPS + i, EPS + i] + q_eps
+    f.p = 0.5 * (p + p.T)
     f.dv_sum = np.zeros(3)
+    f.dtheta_sum = np.zeros(3)
     f.c_start = np.array(c_np, dtype=float)
     f.ticks = 0
-    if not kalman.diagonal_positive(f.p):
+    if not diagonal_healthy(f.p):
         f.healthy = 0
 
 
@@ -177,17 +212,22 @@ def nis_pair(f, k, z, r):
 
 
 def update_pair(f, k0, z, r):
-    """Two scalar Joseph updates of rows k0, k0 + 1 (mirrors update_pair)."""
+    """Two scalar Joseph updates of rows k0, k0 + 1 (mirrors update_pair:
+    A = P - K P(k,:), P' = A - A(:,k) K^T + r K K^T, its upper triangle
+    mirrored)."""
     for c in range(2):
         k = k0 + c
-        s = f.p[k, k] + r[c]
+        pk = f.p[:, k].copy()
+        s = pk[k] + r[c]
         nu = z[c] - f.x[k]
-        gain = f.p[:, k] / s
+        gain = pk / s
         f.x = f.x + gain * nu
-        a = f.p - np.outer(gain, f.p[k, :])
-        f.p = a - np.outer(a[:, k], gain) + r[c] * np.outer(gain, gain)
-        f.p = 0.5 * (f.p + f.p.T)
-    if not kalman.diagonal_positive(f.p):
+        a = f.p - np.outer(gain, pk)
+        aik = pk - gain * pk[k]
+        full = a - np.outer(aik, gain) + r[c] * np.outer(gain, gain)
+        # the upper triangle, mirrored (as the C++)
+        f.p = np.triu(full) + np.triu(full, 1).T
+    if not diagonal_healthy(f.p):
         f.healthy = 0
 
 
@@ -195,4 +235,6 @@ def reset_feedback(f):
     """The biases into the compensation, the state zeroed (mirrors reset_feedback)."""
     f.gyro_bias = f.gyro_bias + f.x[EPS:EPS + 3]
     f.accel_bias = f.accel_bias + np.array([f.x[NABLA], f.x[NABLA + 1], 0.0])
+    f.table_err = f.table_err + f.x[TAB:TAB + 3]
+    f.level_err = f.level_err + f.x[LEV:LEV + 4]
     f.x = np.zeros(STATES)

@@ -194,7 +194,9 @@ def _firmware_config(res, motion):
                          ("fine_site_accel_mps_sqrt_s", "fine_site_accel"),
                          ("nav_gyro_bias_rw_rad_s_sqrt_s", "nav_gyro_bias_rw"),
                          ("nav_table_scale_sigma", "nav_table_scale_sigma"),
-                         ("nav_table_mis_sigma_rad", "nav_table_mis_sigma")):
+                         ("nav_table_mis_sigma_rad", "nav_table_mis_sigma"),
+                         ("nav_level_scale_sigma", "nav_level_scale_sigma"),
+                         ("nav_level_mis_sigma_rad", "nav_level_mis_sigma")):
         if fw[name] is not None:
             cfg[c_name] = fw[name]
     if fw["fine_correction"] is not None:
@@ -295,7 +297,9 @@ _FIELD_KEYS = {"lat_rad": "motion.lat", "lon_rad": "motion.lon", "height_m": "mo
                "fine_site_accel": "firmware.fine_site_accel",
                "nav_gyro_bias_rw": "firmware.nav_gyro_bias_rw",
                "nav_table_scale_sigma": "firmware.nav_table_scale_sigma",
-               "nav_table_mis_sigma": "firmware.nav_table_mis_sigma"}
+               "nav_table_mis_sigma": "firmware.nav_table_mis_sigma",
+               "nav_level_scale_sigma": "firmware.nav_level_scale_sigma",
+               "nav_level_mis_sigma": "firmware.nav_level_mis_sigma"}
 
 
 def _firmware_check(motion, cfg):

@@ -310,14 +310,23 @@ FIRMWARE_KEYS = {
                                                 "their instability (firmware default 0: random "
                                                 "constants)", lo="0 deg/h/sqrt(h)",
                             hi="1e-6 rad/s/sqrt(s)"),
-    "nav_table_scale_sigma": Key("dimensionless", "navigation filter: sigma of the scale factor of "
-                                                  "the gyro on the table's axis, a heading error of "
-                                                  "that fraction of every table move (firmware "
-                                                  "default 0: not modelled; the IMU's own figure, "
-                                                  "e.g. 10 ppm)", lo=0.0, hi=0.01),
-    "nav_table_mis_sigma": Key("angle", "navigation filter: sigma of the other gyros' misalignment "
-                                        "to the table's axis, a tilt of at most that fraction of a "
-                                        "move (firmware default 0: not modelled; e.g. 10 arcsec)",
+    "nav_table_scale_sigma": Key("dimensionless", "navigation filter: prior sigma of the scale "
+                                                  "factor of the gyro on the table's axis, a state "
+                                                  "(a heading error of that fraction of every table "
+                                                  "move; firmware default 0: not modelled; the "
+                                                  "IMU's own figure, e.g. 10 ppm)", lo=0.0, hi=0.01),
+    "nav_table_mis_sigma": Key("angle", "navigation filter: prior sigma of the other gyros' "
+                                        "misalignments to the table's axis, two states (firmware "
+                                        "default 0: not modelled; e.g. 10 arcsec)",
+                               lo="0 arcsec", hi="0.01 rad"),
+    "nav_level_scale_sigma": Key("dimensionless", "navigation filter: prior sigma of the x and y "
+                                                  "gyros' scale factors, two states (firmware "
+                                                  "default 0: not modelled; e.g. 10 ppm)",
+                                 lo=0.0, hi=0.01),
+    "nav_level_mis_sigma": Key("angle", "navigation filter: prior sigma of the x and y gyros' "
+                                        "misalignments to each other, two states: the Earth's rate "
+                                        "through them is a heading error no indexing removes "
+                                        "(firmware default 0: not modelled; e.g. 10 arcsec)",
                                lo="0 arcsec", hi="0.01 rad"),
 }
 

@@ -1,12 +1,13 @@
-"""The navigation filter's model beyond its bias states (nav_gyro_bias_rw,
-nav_table_scale_sigma, nav_table_mis_sigma; csrc/src/nav_filter.hpp):
-what each adds to the covariance, on the reference (the C++ equals it:
-test_xcheck_nav_filter), and that the firmware reads them from its
-configuration (a run with them differs from one without, only after a
-table move for the table's terms)."""
+"""The navigation filter's model beyond its 12 navigation and bias states
+(nav_gyro_bias_rw; nav_table_scale_sigma and nav_table_mis_sigma, the
+priors of the table-axis error states m_xz, m_yz, k_z;
+csrc/src/nav_filter.hpp): what each does to the covariance, on the
+reference (the C++ equals it: test_xcheck_nav_filter); that the firmware
+reads them from its configuration; and that it estimates a table-axis
+scale factor from the ship's data."""
 import numpy as np
 
-from pyins import contract, fil, sim
+from pyins import contract, fil, metrics, sim
 from pyins.reference import earth, nav_filter
 from pyins.sim import references
 from pyins.units import ARCMIN_TO_RAD, DEG_TO_RAD, DT, G0
@@ -31,67 +32,169 @@ def _motion():
     return nav_filter.Motion(np.sin(lat), np.cos(lat), rm, rn, 0.0, 0.0)
 
 
-def _run(model, dalpha):
+def _run(model, dtheta_z):
+    """The filter over ticks whose z increments are dtheta_z, the IMU's
+    attitude turning with them about the vertical (the table's moves)."""
     f = _filter(model)
-    for k, da in enumerate(dalpha):
-        nav_filter.gather(f, np.array([0.0, 0.0, 9.8 * DT]), da)
+    yaw = 0.0
+    for dz in dtheta_z:
+        yaw = yaw + dz
+        nav_filter.gather(f, np.array([0.0, 0.0, 9.8 * DT]), dz)
         if f.ticks == f.prm.every:
-            nav_filter.predict(f, _motion(), np.eye(3))
+            c, s = np.cos(yaw), np.sin(yaw)
+            nav_filter.predict(f, _motion(), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
     return f
 
 
-def test_a_move_adds_its_whole_angle_squared():
-    """A 180-deg move spread over two time updates adds (sigma pi)^2 in all,
-    not the sum of the per-interval squares (the error is a fixed fraction of
-    the whole move); a stop restarts the move's angle."""
-    still, move = np.zeros(70), np.full(60, np.pi / 60.0)
-    dalpha = np.concatenate([still, move, still])          # 200 ticks: two updates, the move across both
-    on, off = _run(True, dalpha), _run(False, dalpha)
-    span = 200 * DT
-    d = np.diag(on.p - off.p)
-    # what the time updates add beyond the propagation (1e-20 rad^2: the
-    # propagation of the added variance over 1 s moves it by < 1e-6 of itself)
+# 0.7 s still; 180 deg at the default 6 deg/s: the time update's mean
+# attitude over a 1-s interval is 6 deg of arc's chord, 5e-4 short of it
+STILL, MOVE = np.zeros(70), np.full(3000, np.pi / 3000.0)
+
+
+def test_a_move_turns_the_heading_by_the_scale_factor_and_the_reverse_move_takes_it_back():
+    """k_z is a state: a 180-deg move adds (sigma_k pi)^2 to the heading's
+    variance, and the reverse move, which the same k_z turns back, takes it
+    away again (a term of Q, redrawn at every move as in ABI 0.18, would
+    have added it twice)."""
+    there = np.concatenate([STILL, MOVE, STILL])
+    back = np.concatenate([there, -MOVE, STILL])
+    span = (there.size // 100) * 100 * DT      # the time updates' (every 100 ticks)
+    d = np.diag(_run(True, there).p - _run(False, there).p)
+    # beyond the propagation (1e-4: the added variance propagated over 31 s
+    # moves by < 1e-5 of itself)
     np.testing.assert_allclose(d[nav_filter.PHI + 2], (SCALE * np.pi) ** 2, rtol=1e-4)
-    np.testing.assert_allclose(d[nav_filter.PHI + 0], (MIS * np.pi) ** 2, rtol=1e-2)
+    # the tilt: |int C(:, j) dalpha| over a half turn is 2 for x and for y,
+    # so 2 (2 sigma_m)^2 over the two level axes (1e-2: the chord's 5e-4 and
+    # the tilt's coupling to the velocity over 31 s)
+    np.testing.assert_allclose(d[nav_filter.PHI + 0] + d[nav_filter.PHI + 1], 2.0 * (2.0 * MIS) ** 2, rtol=1e-2)
     np.testing.assert_allclose(d[nav_filter.EPS], RW * RW * span, rtol=1e-6)
-    # two moves of 90 deg with a stop between: twice (sigma pi / 2)^2, half the one move's
-    half = np.full(30, np.pi / 60.0)
-    two = np.concatenate([still[:40], half, still[:60], half, still[:70]])
-    d2 = np.diag(_run(True, two).p - _run(False, two).p)
-    np.testing.assert_allclose(d2[nav_filter.PHI + 2], 2.0 * (SCALE * np.pi / 2.0) ** 2, rtol=1e-4)
+    d2 = np.diag(_run(True, back).p - _run(False, back).p)
+    # back where it started: what is left is the random walk's share and
+    # the propagation, 1e-3 of one move's (sigma_k pi)^2
+    assert abs(d2[nav_filter.PHI + 2]) < 1e-3 * (SCALE * np.pi) ** 2
+    assert abs(d2[nav_filter.PHI + 0] + d2[nav_filter.PHI + 1]) < 1e-2 * 2.0 * (2.0 * MIS) ** 2
 
 
-def test_no_move_no_table_term():
-    """A table standing still adds nothing to the attitude: with the bias
-    random walk off, the model changes nothing."""
+def test_the_table_states_not_modelled_stay_zero_and_healthy():
+    """nav_table_*_sigma = 0: the three states keep a zero row and column of
+    P through moves and updates, the filter stays healthy (a zero variance
+    there is not a covariance fault) and the compensation stays 0."""
+    f = _filter(False)
+    yaw = 0.0
+    dz_all = np.concatenate([STILL, MOVE, STILL, -MOVE, STILL])
+    for k, dz in enumerate(dz_all):
+        yaw = yaw + dz
+        nav_filter.gather(f, np.array([0.0, 0.0, 9.8 * DT]), dz)
+        if f.ticks == f.prm.every or k % 50 == 49:
+            c, s = np.cos(yaw), np.sin(yaw)
+            nav_filter.predict(f, _motion(), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]))
+        if k % 50 == 49:
+            nav_filter.update_pair(f, nav_filter.POS, np.array([1.0, -2.0]), np.array([9.0, 9.0]))
+            nav_filter.reset_feedback(f)
+    assert f.healthy == 1
+    assert not np.any(f.p[nav_filter.TAB:, :]) and not np.any(f.p[:, nav_filter.TAB:])
+    assert not np.any(f.table_err)
+
+
+def test_the_compensation_removes_what_the_table_states_hold():
+    """compensate_gyro: dtheta_x -= m_xz dtheta_z, dtheta_y -= m_yz
+    dtheta_z, dtheta_z -= k_z dtheta_z, after the biases."""
     f = _filter(True)
-    f.prm.gyro_bias_rw = 0.0
-    for _ in range(300):
-        nav_filter.gather(f, np.array([0.0, 0.0, 9.8 * DT]), 0.0)
-        if f.ticks == f.prm.every:
-            nav_filter.predict(f, _motion(), np.eye(3))
-    np.testing.assert_array_equal(f.p, _run(False, np.zeros(300)).p)
+    f.gyro_bias = np.array([1e-7, -2e-7, 3e-7])
+    f.table_err = np.array([5e-5, -4e-5, 2e-5])
+    d = np.array([1e-4, -3e-4, 0.1])
+    got = nav_filter.compensate_gyro(f, d, DT)
+    want = d - f.gyro_bias * DT - f.table_err * d[2]
+    np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-18)
 
 
 def test_the_firmware_reads_the_model_from_its_configuration():
     """Two-position indexing on a ship at sea with GNSS: the heading sigma the
-    firmware reports grows at each table move with nav_table_scale_sigma and
-    stays as without until the first move."""
+    firmware reports grows at the table's first move with
+    nav_table_scale_sigma; before it only the ship's yaw and the Earth's
+    rate act through k_z."""
     motion = sim.default_voyage(0.25, seed=1)
     n = int(900 / DT)
     g = references.gnss(motion, n * DT, seed=5)
     refs = g.refs.astype(contract.REF_DTYPE)
     base = dict(index_scheme=2, fine_sigma0_att_rad=np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD)
+    sigma_k = 1e-3
     runs = {}
-    for name, extra in (("off", {}), ("on", dict(nav_table_scale_sigma=1e-3, nav_table_mis_sigma=0.0))):
+    for name, extra in (("off", {}), ("on", dict(nav_table_scale_sigma=sigma_k, nav_table_mis_sigma=0.0))):
         res = fil.run_fil(motion, n, config=dict(base, **extra), errors=sim.preset("error_free"), seed=1,
                           every=100, refs=refs, avail_tick=g.avail_tick)
-        runs[name] = (res.outputs["nav_sigma_heading_rad"], res.outputs["table_angle_rad"])
-    s_off, table = runs["off"]
-    s_on, _ = runs["on"]
-    moved = np.flatnonzero(np.abs(np.diff(np.unwrap(table))) > 1e-6)
+        runs[name] = res.outputs
+    off, on = runs["off"], runs["on"]
+    moved = np.flatnonzero(np.abs(np.diff(np.unwrap(off["table_angle_rad"]))) > 1e-6)
     assert moved.size > 0, "the table never moved in 15 min of two-position indexing"
     first = moved[0]
-    np.testing.assert_array_equal(s_on[:first], s_off[:first])
+    # before it: at most sigma_k times the IMU's turn so far (the ship's
+    # yaw, and the Earth's rate: < 1e-3 rad in 15 min)
+    yaw = np.unwrap(off["yaw_p_rad"][:first])
+    turn = np.maximum.accumulate(np.abs(yaw - yaw[0])) + 1e-3
+    grow = on["nav_sigma_heading_rad"][:first] - off["nav_sigma_heading_rad"][:first]
+    # (-1e-9 rad: the two runs' feedback differs in its last bits)
+    assert np.all(grow >= -1e-9) and np.all(grow <= sigma_k * turn)
     # 1e-3 of a 180-deg move is 10.8' of heading: the sigma after it at least 5' above
-    assert np.max(s_on[first:] - s_off[first:]) > 5.0 * ARCMIN_TO_RAD
+    after = on["nav_sigma_heading_rad"][first:] - off["nav_sigma_heading_rad"][first:]
+    assert np.max(after) > 5.0 * ARCMIN_TO_RAD
+    # the estimate stays 0 (an error-free IMU) within what 1 h of the sigma
+    # allows: 1 sigma of the prior
+    assert np.max(np.abs(on["nav_table_err"][:, 2])) < sigma_k
+    assert not np.any(off["nav_table_err"])
+
+
+def test_the_level_states_carry_the_earth_rate_through_the_level_gyros():
+    """The IMU still with x east, y north: the y gyro senses the Earth's
+    north rate W_N, so m_xy (x's sensitivity to the y rate) is an east
+    drift m_xy W_N, and one 1-s time update correlates phi_E with m_xy by
+    -W_N T sigma^2 (phi' = -C(:,0) m_xy w_y); m_yx sees w_x = 0: nothing."""
+    prm = _filter(False).prm
+    prm.level_mis = MIS
+    f = nav_filter.init(prm, np.eye(3))
+    lat = 34.0 * DEG_TO_RAD
+    w_p = earth.OMEGA_IE * np.array([0.0, np.cos(lat), np.sin(lat)])
+    for _ in range(100):
+        nav_filter.gather(f, np.array([0.0, 0.0, 9.8 * DT]), w_p * DT)
+    nav_filter.predict(f, _motion(), np.eye(3))
+    want = -w_p[1] * 1.0 * MIS ** 2
+    # 1e-4: the second-order terms of Phi are W T = 7e-5 of the first
+    np.testing.assert_allclose(f.p[nav_filter.PHI + 0, nav_filter.LEV + 2], want, rtol=1e-4)
+    assert f.p[nav_filter.PHI + 0, nav_filter.LEV + 3] == 0.0
+    assert f.p[nav_filter.PHI + 1, nav_filter.LEV + 3] == 0.0
+
+
+def _heading_run(told):
+    """2 h of the voyage with GNSS and two-position indexing, an IMU whose
+    only errors are level gyros misaligned to each other by +40" and -40"
+    (the gyro triad yawed 40" against the accelerometers: a heading error of
+    40" = 0.67' that neither GNSS nor indexing can show); told: the filter
+    carries nav_level_mis_sigma of 30"."""
+    motion = sim.default_voyage(2.0, seed=1)
+    n = int(2.0 * 3600 / DT)
+    g = references.gnss(motion, n * DT, seed=7)
+    mis = np.zeros((3, 3))
+    mis[0, 1], mis[1, 0] = 40.0 * ARCMIN_TO_RAD / 60.0, -40.0 * ARCMIN_TO_RAD / 60.0
+    errors = sim.SensorErrors(gyro_misalignment=mis)
+    # the filter told seed 002's grade of bias and noise (tools/nees_gnss.py
+    # --prior seed002), so that its heading sigma is 0.1'-0.2', not the
+    # default prior's 0.4'
+    cfg = dict(index_scheme=2, fine_sigma0_att_rad=np.array([2.0, 2.0, 10.0]) * ARCMIN_TO_RAD,
+               fine_sigma0_gyro=0.003 * DEG_TO_RAD / 3600.0, fine_sigma0_accel=30e-6 * G0,
+               fine_gyro_arw=0.0005 * DEG_TO_RAD / 60.0, fine_accel_vrw=5e-6 * G0,
+               nav_level_mis_sigma=(30.0 * ARCMIN_TO_RAD / 60.0) if told else 0.0)
+    res = fil.run_fil(motion, n, config=cfg, errors=errors, seed=1, every=100,
+                      refs=g.refs.astype(contract.REF_DTYPE), avail_tick=g.avail_tick)
+    e = metrics.nav_errors(res)
+    late = e.time_s >= 3600.0
+    return e.att_n_rad[late, 2], res.outputs["nav_sigma_heading_rad"][late]
+
+
+def test_a_yawed_gyro_triad_is_inside_the_heading_sigma_only_when_told():
+    """Not told, the heading error (the triad's 40" yaw: 0.67') sits outside
+    3 sigma of a filter that believes 0.1'; told 30" of level misalignment,
+    the sigma covers it (|error| < 3 sigma all through the second hour)."""
+    err, sig = _heading_run(False)
+    assert np.median(np.abs(err) / sig) > 3.0
+    err, sig = _heading_run(True)
+    assert np.all(np.abs(err) < 3.0 * sig)

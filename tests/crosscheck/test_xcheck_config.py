@@ -65,6 +65,8 @@ FIELDS = {
                                np.nextafter(config.MAX_NAV_GYRO_BIAS_RW, 1.0), -1e-12, NAN, INF),
     "nav_table_scale_sigma": values(0.0, 1e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, NAN),
     "nav_table_mis_sigma": values(0.0, 4.8e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, INF),
+    "nav_level_scale_sigma": values(0.0, 1e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, NAN),
+    "nav_level_mis_sigma": values(0.0, 4.8e-5, config.MAX_NAV_TABLE_SIGMA, 0.0100001, -1e-6, INF),
 }
 
 

@@ -27,19 +27,20 @@ def _m6(m):
 @settings(max_examples=60, deadline=None)
 @given(lat=st.floats(-80.0, 80.0), ve=st.floats(-15.0, 15.0), vn=st.floats(-15.0, 15.0),
        f=st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(8, 12)),
-       euler=st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.floats(-3.1, 3.1)))
-def test_system_matrix(lat, ve, vn, f, euler):
+       euler=st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.floats(-3.1, 3.1)),
+       w_p=st.tuples(st.floats(-0.2, 0.2), st.floats(-0.2, 0.2), st.floats(-0.2, 0.2)))
+def test_system_matrix(lat, ve, vn, f, euler, w_p):
     m = _motion(lat * DEG_TO_RAD, ve, vn)
     c = attitude.euler_to_mat(np.array(euler))
-    want = nav_filter.system_matrix(m, np.array(f), c)
-    got = hooks.call("nav_system_matrix", _m6(m), f, c, n_out=144).reshape(12, 12)
+    want = nav_filter.system_matrix(m, np.array(f), c, np.array(w_p))
+    got = hooks.call("nav_system_matrix", _m6(m), f, c, w_p, n_out=133).reshape(7, 19)
     # the same operations on the same doubles: bit for bit
     assert np.array_equal(got, want)
 
 
 def _params(every, model=False):
     """model: the filter's model beyond its bias states on (a bias random
-    walk, the table's scale factor and misalignment), else off."""
+    walk, the gyros' scale factors and misalignments as states), else off."""
     return nav_filter.Params(dt=DT, every=every, reject_limit=10, gyro_arw=0.001 * DEG_TO_RAD / 60.0,
                              accel_vrw=10e-6 * G0, gate=13.8155,
                              sigma0_att=np.array([1.0, 1.0, 10.0]) * ARCMIN_TO_RAD, sigma0_vel=0.1,
@@ -47,7 +48,9 @@ def _params(every, model=False):
                              sigma0_accel=100e-6 * G0,
                              gyro_bias_rw=(0.001 * DEG_TO_RAD / 3600.0 / 60.0) if model else 0.0,
                              table_scale=10e-6 if model else 0.0,
-                             table_mis=(10.0 / 206264.8) if model else 0.0)
+                             table_mis=(10.0 / 206264.8) if model else 0.0,
+                             level_scale=10e-6 if model else 0.0,
+                             level_mis=(10.0 / 206264.8) if model else 0.0)
 
 
 @settings(max_examples=25, deadline=None)
@@ -57,11 +60,12 @@ def _params(every, model=False):
 def test_filter_run(seed, every, n, lat, speed, outlier, model):
     rng = np.random.default_rng(seed)
     prm = _params(every, model)
-    # the table: still, then moves of 0.1 rad a tick for a random number of
-    # ticks either way, still again (the move's angle restarts at each stop)
-    dalpha = np.zeros(n)
+    # the angle increments: the ship's swing and slow yaw, and table moves
+    # of 0.1 rad a tick for a random number of ticks either way
+    dtheta = rng.normal(0.0, 1e-3, (n, 3))
+    dtheta[:, 2] += 0.001
     for start in rng.integers(0, n, 3):
-        dalpha[start:start + rng.integers(1, 40)] = rng.choice([-0.1, 0.1])
+        dtheta[start:start + rng.integers(1, 40), 2] += rng.choice([-0.1, 0.1])
     yaw = rng.uniform(-np.pi, np.pi, n)
     euler = np.column_stack([rng.normal(0, 0.05, n), rng.normal(0, 0.05, n), np.cumsum(np.full(n, 0.001)) + yaw[0]])
     c = np.array([attitude.euler_to_mat(e) for e in euler])
@@ -77,7 +81,7 @@ def test_filter_run(seed, every, n, lat, speed, outlier, model):
     f = nav_filter.init(prm, c[0])
     nis_ref = np.zeros(n)
     for k in range(n):
-        nav_filter.gather(f, dv[k], dalpha[k])
+        nav_filter.gather(f, dv[k], dtheta[k])
         if f.ticks == f.prm.every:
             nav_filter.predict(f, motions[k], c[k])
         if kind[k]:
@@ -90,14 +94,15 @@ def test_filter_run(seed, every, n, lat, speed, outlier, model):
                 f.c_start = c[k]
     p = ffi.new("pyins_t_nav_params *")
     for name in ("dt", "every", "reject_limit", "gyro_arw", "accel_vrw", "gate", "sigma0_vel",
-                 "sigma0_pos", "sigma0_gyro", "sigma0_accel", "gyro_bias_rw", "table_scale", "table_mis"):
+                 "sigma0_pos", "sigma0_gyro", "sigma0_accel", "gyro_bias_rw", "table_scale", "table_mis",
+                 "level_scale", "level_mis"):
         setattr(p, name, getattr(prm, name))
     p.sigma0_att = list(prm.sigma0_att)
     keep = [np.ascontiguousarray(a, dtype=np.float64) for a in
-            (c[0], dv, dalpha, [_m6(m) for m in motions], c.reshape(n, 9), z, r)]
+            (c[0], dv, dtheta, [_m6(m) for m in motions], c.reshape(n, 9), z, r)]
     kinds = np.ascontiguousarray(kind)
     nis = np.zeros(n)
-    x_out, p_out, b_out = np.zeros(12), np.zeros(144), np.zeros(6)
+    x_out, p_out, b_out = np.zeros(19), np.zeros(361), np.zeros(13)
     ptr = [ffi.from_buffer("double[]", a) for a in keep]
     lib.pyins_t_nav_filter_run(p, ptr[0], ptr[1], ptr[2], ptr[3], ptr[4], ffi.from_buffer("int32_t[]", kinds),
                                ptr[5], ptr[6], n, ffi.from_buffer("double[]", nis),
@@ -106,8 +111,15 @@ def test_filter_run(seed, every, n, lat, speed, outlier, model):
     # summation order differs (Eigen's coefficient products, NumPy's @): 1e-9 relative
     assert np.allclose(nis, nis_ref, rtol=1e-9, atol=1e-12)
     scale = np.sqrt(np.outer(np.diag(f.p), np.diag(f.p)))
-    assert np.all(np.abs(p_out.reshape(12, 12) - f.p) <= 1e-9 * scale)
-    assert np.allclose(b_out, np.concatenate([f.gyro_bias, f.accel_bias]), rtol=1e-8, atol=1e-20)
-    # the covariance stays symmetric positive definite
-    assert np.array_equal(p_out.reshape(12, 12), p_out.reshape(12, 12).T)
-    assert np.all(np.linalg.eigvalsh(p_out.reshape(12, 12)) > 0.0)
+    assert np.all(np.abs(p_out.reshape(19, 19) - f.p) <= 1e-9 * scale)
+    assert np.allclose(b_out, np.concatenate([f.gyro_bias, f.accel_bias, f.table_err, f.level_err]),
+                       rtol=1e-8, atol=1e-20)
+    # the covariance stays symmetric positive definite (semi-definite with
+    # the gyros' scale and misalignment states not modelled: their rows and
+    # columns stay 0)
+    pc = p_out.reshape(19, 19)
+    assert np.array_equal(pc, pc.T)
+    live = slice(0, 19) if model else slice(0, nav_filter.TAB)
+    assert np.all(np.linalg.eigvalsh(pc[live, live]) > 0.0)
+    if not model:
+        assert not np.any(pc[nav_filter.TAB:, :]) and not np.any(b_out[6:])

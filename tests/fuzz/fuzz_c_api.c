@@ -63,7 +63,7 @@
 
 #include "pyins_core.h"
 
-#define MEM_MAX 16384u
+#define MEM_MAX 20480u
 #define SNAP_MAX (MEM_MAX + 256u)
 #define MAX_TICKS 4096u
 #define MAX_BATCH 256u

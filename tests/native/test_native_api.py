@@ -19,7 +19,7 @@ def static_samples(n, lat=0.5):
 def test_layout_matches_library():
     assert native.SAMPLE_DTYPE.itemsize == native.lib.pyins_sizeof_sample() == 64
     assert native.SAMPLE_DTYPE.fields["seq"][1] == 56
-    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 640   # + navigation at sea (ABI 0.15)
+    assert native.OUTPUT_DTYPE.itemsize == native.lib.pyins_sizeof_output() == 696   # + navigation at sea (ABI 0.15), + the gyros' scale factors and misalignments (0.19)
     assert native.OUTPUT_DTYPE.itemsize % 8 == 0
     assert native.NAV_DTYPE.itemsize == native.lib.pyins_sizeof_nav() == 168   # the compact record (ABI 0.12), + nav_mode, ref_in_use (0.15)
     assert set(native.NAV_DTYPE.names) < set(native.OUTPUT_DTYPE.names)
