@@ -257,6 +257,14 @@ void step_machine(Indexer& ix, double meas, double sin_yaw_p, double cos_yaw_p) 
     if (off_command(ix, meas, Fault::kLag)) {
         return;
     }
+    if (arrived && !ix.target_known) {
+        // the provisional end (max_flex from the start) reached on this
+        // tick without the condition met: the fallback, taken now (the test
+        // above sees it only on the next tick, which stood the table still
+        // one tick as part of the move)
+        ix.target_known = true;
+        ix.fallbacks = ix.fallbacks + 1;
+    }
     if (arrived && ix.target_known) {
         ix.step = (ix.step + 1) % ix.prm.n_steps;
         start_stop(ix);

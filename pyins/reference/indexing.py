@@ -261,6 +261,11 @@ def _step_machine(ix, meas, sin_yaw_p, cos_yaw_p):
     rate_iso = (ix.cmd_angle - before) / ix.prm.dt + ix.hold_rate
     if _off_command(ix, meas, FAULT_LAG):
         return
+    if arrived and not ix.target_known:
+        # the provisional end (max_flex) reached without the condition: the
+        # fallback, taken on this tick (mirrors step_machine)
+        ix.target_known = True
+        ix.fallbacks = ix.fallbacks + 1
     if arrived and ix.target_known:
         ix.step = (ix.step + 1) % ix.prm.n_steps
         _start_stop(ix)

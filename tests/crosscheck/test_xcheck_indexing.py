@@ -96,8 +96,11 @@ def test_scheme_rules(setup):
         [[meas0], rec["cmd_angle"]])))), rtol=1e-12, atol=1e-12)
     if prm.isolate:
         return      # the rules below are of a table that stands still between moves
-    # without isolation a motor start is a move leaving its stop
-    assert rec["motor_starts"][-1] == np.count_nonzero(np.diff(state) == ix.STATE_MOVE - ix.STATE_STOP)
+    # without isolation a motor start is a move leaving its stop: the rate
+    # leaves 0 on the move's second tick (its first commands rate 0), so a
+    # move that begins on the record's last tick has not started the motor yet
+    assert np.all(rec["cmd_rate"][np.flatnonzero(np.diff(state) == ix.STATE_MOVE - ix.STATE_STOP) + 1] == 0.0)
+    assert rec["motor_starts"][-1] == np.count_nonzero(np.diff(state)[:-1] == ix.STATE_MOVE - ix.STATE_STOP)
     # the ticks that accumulate: A_c or A_s changed (cos and sin are never both 0)
     prev_ac = np.concatenate([[0.0], rec["a_c"][:-1]])
     prev_as = np.concatenate([[0.0], rec["a_s"][:-1]])
@@ -153,3 +156,40 @@ def test_scheme_rules(setup):
                     assert rates[f0 - 1] >= rates[f0 - 2] if f0 > 1 else True
             else:
                 assert abs(d) >= prm.max_flex - 1e-9 or end == len(state) - 1
+
+
+def test_a_flexible_fallback_ends_its_turn_on_the_tick_it_arrives():
+    """delta = 0: no heading ever meets the flexible condition, so every
+    flexible turn runs to its max_flex fallback (here 180 deg). The turn ends
+    on the tick the command reaches it: no tick of the move stands still, the
+    stop that follows lasts exactly its ticks, and each fallback is counted
+    once (until 2026-12-05 the fallback was seen a tick late, and the table
+    stood still one tick longer than its stop; C++ and NumPy alike)."""
+    stop = 150
+    prm = ix.Params(steps=ix.preset_steps(4, stop), rate=6.0 * DEG, accel=30.0 * DEG, delta=0.0,
+                    max_flex=np.pi, tolerance=0.5 * DEG, jump=5.0 * DEG, timeout_ticks=200, dt=DT,
+                    sums=ix.SUMS_STOPS, isolate=0)
+    yaw_b = np.full(20_000, 0.3)
+    r = np.array(ix.run(prm, 0.0, None, yaw_b), dtype=RECORD)
+    c = c_run(prm, 0.0, yaw_b)
+    for f in ("state", "step", "fallbacks"):
+        assert np.array_equal(c[f], r[f]), f
+    moves = np.flatnonzero(np.diff(r["state"]) == ix.STATE_MOVE - ix.STATE_STOP) + 1
+    stops = np.flatnonzero(np.diff(r["state"]) == ix.STATE_STOP - ix.STATE_MOVE) + 1
+    # scheme 4: flexible turns (to their fallback) alternate with fixed returns of 180 deg
+    flexible = [a for a in moves if prm.steps[r["step"][a]].kind != ix.KIND_FIXED and np.any(stops > a)]
+    assert len(flexible) >= 3 and r["fallbacks"][-1] == len(flexible)
+    for a in moves:
+        b = stops[stops > a]
+        if len(b) == 0:
+            break
+        b = b[0]
+        # the stop begins on the tick the command arrives (that tick still
+        # turned it: no tick standing still between turn and stop); the
+        # turn is 180 deg
+        assert r["cmd_angle"][b] != r["cmd_angle"][b - 1]
+        assert abs(r["cmd_angle"][b] - r["cmd_angle"][a - 1]) == np.pi
+        # the stop after it: exactly stop_ticks
+        nxt = moves[moves > b]
+        if len(nxt):
+            assert nxt[0] - b == stop
