@@ -202,11 +202,12 @@ def test_gnss_aided_fil_reference_engine_agrees():
     m = _voyage()
     n = 12_000
     g = _gnss(m, n / 100)
-    # the table indexed after each 30-s stop and the filter told its move model and a
-    # bias random walk (ABI 0.18): the moves' growth of the covariance runs
-    # in both engines (seed 002's grade: 10 ppm, 10", 0.0007 deg/h/sqrt(h))
+    # the table indexed after each 30-s stop and the filter told the gyros'
+    # scale factors and misalignments as states (ABI 0.19) and a bias random
+    # walk: the states the moves and the Earth's rate excite run in both
+    # engines (seed 002's grade: 10 ppm, 10", 0.0007 deg/h/sqrt(h))
     cfg = dict(CFG, index_stop_ticks=3_000, nav_table_scale_sigma=10e-6, nav_table_mis_sigma=4.85e-5,
-               nav_gyro_bias_rw=5.66e-11)
+               nav_level_scale_sigma=10e-6, nav_level_mis_sigma=4.85e-5, nav_gyro_bias_rw=5.66e-11)
     kw = dict(KW, every=1, chunk_ticks=5_000, config=cfg)
     t0 = time.perf_counter()
     a = fil.run_fil(m, n, refs=g.refs, **kw)

@@ -79,3 +79,22 @@ def test_a_moored_ship_with_gnss_beats_the_static_limit():
         err.append(h[int(np.searchsorted(t, 599.0))])
         lim.append(limit)
     assert np.median(np.abs(err)) <= 0.5 * np.median(np.abs(lim))
+
+
+def test_the_mirror_aligns_alike():
+    """The indexed alignments through the C++ core and through the NumPy
+    mirror (firmware and plant), each of its 600 s: every decision
+    identical (modes, indexing, references used and rejected), the floats
+    within tests/engines.py's bounds (the NIS of the pier's zero velocity,
+    0.001 m/s, to 1e-6 absolute: engines.py says why)."""
+    import sys
+    sys.path.insert(0, str(ROOT / "tests"))
+    from engines import assert_engines_agree
+    from pyins import scenario
+    from pyins.run_scenario import run
+    for name in ("pier_indexed", "moored_indexed"):
+        spec = next(iter(scenario.load(name).runs()))
+        a = run(spec).outputs
+        b = run(spec, engine="reference").outputs
+        assert len(a) == len(b) and np.any(a["index_state"] != a["index_state"][0]), name
+        assert_engines_agree(a, b, nis_abs=1e-6)
