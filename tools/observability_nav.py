@@ -1,12 +1,17 @@
 #!/usr/bin/env python3
 """What the turntable makes observable in the integrated navigation filter at
-sea: a covariance analysis of the firmware's 12-state filter along a
+sea: a covariance analysis of the firmware's filter along a
 simulated voyage with GNSS, and the firmware's bias estimates against the
 truth (docs/observability.md).
 
     .venv/bin/python tools/observability_nav.py [--hours 24] [--est-hours 6] [--seeds 6]
-                                               [--no-estimates] [--no-fil-check]
+                                               [--no-estimates] [--no-fil-check] [--gyro-states]
                                                [--noise filter|sensor] [--out docs/results]
+
+The analysis is of the filter's 12 navigation and bias states (the seven
+scale-factor and misalignment states of ABI 0.19 held at 0);
+``--gyro-states`` runs it again with them at the scenario's priors
+(docs/observability.md, section 5b).
 
 ~2.5-3 min with the defaults on a shared 2-core machine (the covariance
 analysis ~1 min: 6 cases x 86,400 s of the mirror's filter; the firmware
@@ -87,6 +92,8 @@ DPH = DEG_TO_RAD / 3600.0          #: 1 deg/h [rad/s]
 UG = 1e-6 * G0                     #: 1 ug [m/s^2]
 STATE_NAMES = ("phi_E", "phi_N", "phi_U", "dv_E", "dv_N", "dp_E", "dp_N",
                "eps_x", "eps_y", "eps_z", "nabla_x", "nabla_y")
+#: with the seven scale-factor and misalignment states (ABI 0.19; held at 0 unless --gyro-states)
+ALL_STATE_NAMES = STATE_NAMES + ("m_xz", "m_yz", "k_z", "k_x", "k_y", "m_xy", "m_yx")
 N_FRAME_NAMES = ("eps_E", "eps_N", "eps_U", "nabla_E", "nabla_N")
 CHECK_HOURS = (1.0, 6.0, 24.0)
 
@@ -107,6 +114,8 @@ class Setup:
     errors: sim.SensorErrors    #: the scenario's sensor errors (seed 002)
     seed: int                   #: the sensors' noise seed
     scheme: str                 #: the scenario's indexing scheme
+    gyro_states: tuple = (0.0, 0.0, 0.0, 0.0)   #: the scenario's nav_table_scale_sigma, nav_table_mis_sigma,
+                                                #: nav_level_scale_sigma, nav_level_mis_sigma (ABI 0.19)
 
 
 def _or(value, default):
@@ -154,7 +163,10 @@ def setup_from_scenario(name="voyage_gnss"):
     phi0 = np.array(_or(r["initial_errors"]["phi_rad"], [0.0, 0.0, 0.0]), dtype=float)
     return Setup(lat=m["lat_rad"], lon=m["lon_rad"], height=m["height_m"], route_seed=m["route_seed"],
                  sea=None if m["sea"] == "none" else m["sea"], prm=prm, gnss=gnss, phi0=phi0, errors=errors,
-                 seed=r["seed"], scheme=r["indexing"]["scheme"])
+                 seed=r["seed"], scheme=r["indexing"]["scheme"],
+                 gyro_states=tuple(float(_or(fw[k], 0.0)) for k in (
+                     "nav_table_scale_sigma", "nav_table_mis_sigma_rad", "nav_level_scale_sigma",
+                     "nav_level_mis_sigma_rad")))
 
 
 def make_voyage(setup, hours, straight=False, dt=DT):
@@ -247,7 +259,10 @@ def table_profile(scheme, dt=DT):
 # ---------------------------------------------------------------------------
 def truth_per_interval(motion, table, n_intervals, interval_s):
     """C_p^n at the interval ends (n + 1, 3, 3), the mean specific force in n
-    over each interval (n, 3) and the Motion (nav_filter.Motion) at each end."""
+    over each interval (n, 3), the Motion (nav_filter.Motion) at each end,
+    the table angle at each end and the mean rate w_ip^p over each interval
+    (n, 3): the rotation vector of C_p^n(k)^T C_p^n(k + 1) over the interval
+    plus w_in^n at the two ends' mean, turned into p by their mean attitude."""
     t = np.arange(n_intervals + 1, dtype=float) * interval_s
     st = motion.state(t)
     cbn = sim.euler_to_mat(st.euler)
@@ -268,7 +283,16 @@ def truth_per_interval(motion, table, n_intervals, interval_s):
     f_n = np.diff(v, axis=0) / interval_s + 0.5 * (extra[1:] + extra[:-1])
     motions = [nav_filter.Motion(float(s[k]), float(c[k]), float(rm_h[k]), float(rn_h[k]), float(v[k, 0]),
                                  float(v[k, 1])) for k in range(len(t))]
-    return cpn, f_n, motions, alpha
+    # w_np^p from the relative rotation over each interval (log map of a rotation < pi)
+    d = np.einsum("kji,kjl->kil", cpn[:-1], cpn[1:])
+    ang = np.arccos(np.clip(0.5 * (np.trace(d, axis1=1, axis2=2) - 1.0), -1.0, 1.0))
+    axis = np.stack([d[:, 2, 1] - d[:, 1, 2], d[:, 0, 2] - d[:, 2, 0], d[:, 1, 0] - d[:, 0, 1]], axis=1)
+    scale = np.where(ang > 1e-12, ang / (2.0 * np.sin(np.maximum(ang, 1e-12))), 0.5)
+    w_np = axis * scale[:, None] / interval_s
+    w_in = np.stack([-v[:, 1] / rm_h, w * c + v[:, 0] / rn_h, w * s + v[:, 0] * (s / c) / rn_h], axis=1)
+    c_mid = 0.5 * (cpn[:-1] + cpn[1:])
+    w_p = w_np + np.einsum("kji,kj->ki", c_mid, 0.5 * (w_in[:-1] + w_in[1:]))
+    return cpn, f_n, motions, alpha, w_p
 
 
 # ---------------------------------------------------------------------------
@@ -290,23 +314,29 @@ class Covariance:
     sigma_pred: np.ndarray      #: (n + 1, 12) the same before them (after the time update): what the
                                 #: firmware's record of that tick carries (a fix of tick T is applied after
                                 #: tick T's record)
-    sigma0: np.ndarray          #: (12,)
+    sigma0: np.ndarray          #: (19,): 0 for the states not modelled
     sigma_n: np.ndarray         #: (n + 1, 5) eps_E, eps_N, eps_U, nabla_E, nabla_N (projected with C_p^n)
     p_at: dict                  #: hour -> P (12, 12) at the check times
     alpha: np.ndarray           #: the table angle at the interval ends [rad]
 
 
-def covariance(setup, motion, table, hours, noise="filter", check_hours=CHECK_HOURS):
+def covariance(setup, motion, table, hours, noise="filter", check_hours=CHECK_HOURS, gyro_states=False):
     """The filter's covariance along ``motion`` with ``table`` for ``hours``,
-    with the mirror's own init / predict / update_pair (module docstring)."""
+    with the mirror's own init / predict / update_pair (module docstring).
+    ``gyro_states``: the seven scale-factor and misalignment states (ABI
+    0.19) with the scenario's priors, driven by the truth's mean rates;
+    else held at 0 (the 12 states of the figures in docs/observability.md)."""
     prm = setup.prm
+    if gyro_states:
+        ts, tm, ls, lm = setup.gyro_states
+        prm = replace(prm, table_scale=ts, table_mis=tm, level_scale=ls, level_mis=lm)
     if noise == "sensor":
         prm = replace(prm, gyro_arw=setup.errors.gyro_arw, accel_vrw=setup.errors.accel_vrw)
     interval = prm.every * prm.dt
     if abs(interval * setup.gnss["rate_hz"] - 1.0) > 1e-9:
         raise ValueError("the analysis takes one GNSS fix per time update")
     n = int(round(hours * 3600.0 / interval))
-    cpn, f_n, motions, alpha = truth_per_interval(motion, table, n, interval)
+    cpn, f_n, motions, alpha, w_p = truth_per_interval(motion, table, n, interval)
     r_pos, r_vel = gnss_variances(setup, motion)
     f = nav_filter.init(prm, cpn[0])
     sigma = np.empty((n + 1, nav_filter.STATES))
@@ -332,6 +362,7 @@ def covariance(setup, motion, table, hours, noise="filter", check_hours=CHECK_HO
     for k in range(1, n + 1):
         # the ticks' specific-force increments gathered (their sum over the interval)
         f.dv_sum = f_n[k - 1] * interval
+        f.dtheta_sum = w_p[k - 1] * interval
         f.ticks = prm.every
         nav_filter.predict(f, motions[k], cpn[k])
         sigma_pred[k] = np.sqrt(np.diag(f.p))
@@ -351,14 +382,17 @@ def least_observed(cov, hour, count=3):
     """The ``count`` directions of P normalised by the prior that shrank least
     (eigenvalues of D0^-1 P D0^-1, D0 = diag(sigma0)), each with its states
     of weight > 0.3: [(sqrt(eigenvalue), {state: component})]."""
-    d = 1.0 / cov.sigma0
-    pn = cov.p_at[hour] * np.outer(d, d)
+    # the states with a prior (those not modelled, held at 0, are left out)
+    live = np.flatnonzero(cov.sigma0 > 0.0)
+    names = [ALL_STATE_NAMES[j] for j in live]
+    d = 1.0 / cov.sigma0[live]
+    pn = cov.p_at[hour][np.ix_(live, live)] * np.outer(d, d)
     val, vec = np.linalg.eigh(pn)
     out = []
     for i in np.argsort(val)[::-1][:count]:
         v = vec[:, i] * np.sign(vec[np.argmax(np.abs(vec[:, i])), i])
         out.append((float(np.sqrt(max(val[i], 0.0))),
-                    {STATE_NAMES[j]: round(float(v[j]), 2) for j in np.argsort(-np.abs(v)) if abs(v[j]) > 0.3}))
+                    {names[j]: round(float(v[j]), 2) for j in np.argsort(-np.abs(v)) if abs(v[j]) > 0.3}))
     return out
 
 
@@ -557,7 +591,7 @@ def sigma_table(covs, hours):
             if h > hours:
                 continue
             k = int(round(h * 3600.0 / (cov.time_s[1] - cov.time_s[0])))
-            ratio = cov.sigma[k] / cov.sigma0
+            ratio = cov.sigma[k, :len(STATE_NAMES)] / cov.sigma0[:len(STATE_NAMES)]
             s0n = np.array([cov.sigma0[nav_filter.EPS]] * 3 + [cov.sigma0[nav_filter.NABLA]] * 2)
             rows.append(dict(case=label, hours=h, ratio=dict(zip(STATE_NAMES, map(float, ratio))),
                              ratio_n=dict(zip(N_FRAME_NAMES, map(float, cov.sigma_n[k] / s0n)))))
@@ -734,6 +768,9 @@ def main(argv=None):
                     help="noise and receiver seeds of the spread with and without the receiver's bias "
                          "(default 6; 0: none)")
     ap.add_argument("--scenario", default="voyage_gnss")
+    ap.add_argument("--gyro-states", action="store_true",
+                    help="also the analysis with the seven scale-factor and misalignment states at the "
+                         "scenario's priors (ABI 0.19): their sigma / prior and the heading's")
     ap.add_argument("--out", default=os.path.join(os.path.dirname(__file__), "..", "docs", "results"))
     a = ap.parse_args(argv)
     t_all = time.perf_counter()
@@ -766,6 +803,35 @@ def main(argv=None):
     for label, cov in covs.items():
         least[label] = least_observed(cov, h_last)
         print(f"  {label:24s} " + "; ".join(f"{s:.2f} {d}" for s, d in least[label]))
+
+    gyro = {}
+    if a.gyro_states:
+        if not any(setup.gyro_states):
+            raise SystemExit(f"--gyro-states: {a.scenario} sets none of the four priors")
+        t0 = time.perf_counter()
+        gcovs = {}
+        for scheme, straight in CASES:
+            motion = make_voyage(setup, a.hours, straight, dt=1.0)
+            gcovs[case_label(scheme, straight)] = covariance(setup, motion, table_profile(scheme), a.hours,
+                                                             a.noise, gyro_states=True)
+        names = ("m_xz", "m_yz", "k_z", "k_x", "k_y", "m_xy", "m_yx")
+        print(f"\nwith the seven scale-factor and misalignment states (priors {setup.gyro_states[0] * 1e6:g} ppm, "
+              f"{setup.gyro_states[1] / ARCSEC_TO_RAD:g} arcsec, {setup.gyro_states[2] * 1e6:g} ppm, "
+              f"{setup.gyro_states[3] / ARCSEC_TO_RAD:g} arcsec; {time.perf_counter() - t0:.1f} s): "
+              "sigma / prior, and the heading sigma against the 12 states'")
+        print(f"{'case':24s} {'t/h':>4s} " + " ".join(f"{n:>7s}" for n in names) + f" {'phi_U':>8s} {'12 st.':>8s}")
+        for label, cov in gcovs.items():
+            for h in CHECK_HOURS:
+                if h > a.hours:
+                    continue
+                k = int(round(h * 3600.0 / (cov.time_s[1] - cov.time_s[0])))
+                r = cov.sigma[k, nav_filter.TAB:] / cov.sigma0[nav_filter.TAB:]
+                hd, h12 = cov.sigma[k, nav_filter.PHI + 2], covs[label].sigma[k, nav_filter.PHI + 2]
+                gyro.setdefault(label, []).append(dict(hours=h, ratio=dict(zip(names, map(float, r))),
+                                                       heading_arcmin=float(hd / (DEG_TO_RAD / 60)),
+                                                       heading_12_arcmin=float(h12 / (DEG_TO_RAD / 60))))
+                print(f"{label:24s} {h:4.0f} " + " ".join(f"{_fmt(x):>7s}" for x in r)
+                      + f" {hd / (DEG_TO_RAD / 60):7.3f}' {h12 / (DEG_TO_RAD / 60):7.3f}'")
 
     # 2. the estimates against the truth
     est, est_rows, fil_rows, t_est, t_fil, spread = {}, [], None, 0.0, 0.0, {}
@@ -839,7 +905,7 @@ def main(argv=None):
                             heading_arcmin=lim["heading_rad"] / (DEG_TO_RAD / 60.0),
                             level_ratio=lim["level_rad"] / setup.prm.sigma0_att[0],
                             heading_ratio=lim["heading_rad"] / setup.prm.sigma0_att[2]),
-        estimates=est_rows, seed_spread=spread, fil_check=fil_rows,
+        estimates=est_rows, seed_spread=spread, fil_check=fil_rows, gyro_states=gyro,
         misalignment_prediction=dict(accel_offset_ug=(misalignment_prediction(setup.errors)[0] / UG).tolist(),
                                      tilt_p_arcsec=(misalignment_prediction(setup.errors)[1] / ARCSEC_TO_RAD).tolist()),
         wall_s=dict(covariance=t_cov, estimates=t_est, fil_check=t_fil, total=time.perf_counter() - t_all))
