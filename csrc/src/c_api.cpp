@@ -48,7 +48,7 @@ constexpr uint32_t kSnapFormat = 8u;  // 2: sample-level fault state (seq, count
                                       // mounting in the configuration (ABI 0.16); 6: the damping
                                       // references of nav_mode DAMPED (ABI 0.17); 7: the navigation
                                       // filter's bias random walk and table-move model (ABI 0.18); 8: the
-                                      // table-axis errors as filter states (ABI 0.19)
+                                      // gyros' scale factors and misalignments as filter states (ABI 0.19)
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).

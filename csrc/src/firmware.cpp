@@ -787,8 +787,8 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
         fine_tick(dtheta_p, dv_p);
     } else {
         if (nav_on_ != 0) {
-            // the biases and table-axis errors the filter estimated,
-            // compensated (0 until it has)
+            // the biases, scale factors and misalignments the filter
+            // estimated, compensated (0 until it has)
             const Vec3 dtheta_c = nav_filter::compensate_gyro(nav_, dtheta_p, dt_);
             const Vec3 dv_sf_n = strapdown::update(sd_, dtheta_c, dv_p - nav_.accel_bias * dt_, dt_);
             nav_tick(dv_sf_n, dtheta_c);

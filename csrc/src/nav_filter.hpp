@@ -36,8 +36,8 @@
 // dv, rw^2 T on eps), symmetrised, as moving_align.
 // The table's axis: three states beyond the biases, the errors of the gyro
 // triad that the table's own turns expose (its rate, 6 deg/s by default,
-// is 1,400 times the Earth's): the misalignments m_xz, m_yz of the x and y gyros
-// to the table's axis z (x senses m_xz w_z) and the scale factor k_z of
+// is 1,400 times the Earth's): the misalignments m_xz, m_yz of the x and
+// y gyros to the table's axis z (x senses m_xz w_z) and the scale factor k_z of
 // the gyro on it, X[kTab..kTab+2] = [m_xz m_yz k_z], random constants
 // whose priors are nav_table_mis_sigma and nav_table_scale_sigma (0: the
 // state stays 0, not modelled). Their rows of F are those of eps times the
@@ -45,8 +45,9 @@
 // z rate over the interval (the sum of dtheta_z / T; with the mean C_p^n,
 // as eps). A turn of the table by a then moves the heading by k_z a and
 // the tilt by m times the level axes' integral over the turn (2 m for a
-// half turn), the reverse turn takes them back, and the filter learns them from the tilt's and the
-// heading's response instead of taking each move's error as a fresh draw,
+// half turn), the reverse turn takes them back, and the filter learns
+// them from the tilt's and the heading's response instead of taking each
+// move's error as a fresh draw,
 // which loses the heading that the tilt's growth carries (0.64' against
 // 0.29' RMS over 6 h, ABI 0.18; docs/concepts.md, "At sea"). Feedback: into
 // the compensation, dtheta_x -= m_xz dtheta_z, dtheta_y -= m_yz dtheta_z,
@@ -188,8 +189,8 @@ double nis_pair(const NavFilter& f, int k, const double z[2], const double r[2])
 /// Two scalar Joseph updates of rows k, k + 1.
 void update_pair(NavFilter& f, int k, const double z[2], const double r[2]);
 
-/// After the firmware has fed phi, dv, dp back: the biases and the
-/// table-axis errors into the compensation, the state zeroed.
+/// After the firmware has fed phi, dv, dp back: the biases, scale factors
+/// and misalignments into the compensation, the state zeroed.
 void reset_feedback(NavFilter& f);
 
 }  // namespace pyins::nav_filter

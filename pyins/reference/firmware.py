@@ -578,8 +578,8 @@ class Firmware(NavAtSea):
                 self.end_fine()
         else:
             if self.nav_on:
-                # the biases and table-axis errors the filter estimated,
-                # compensated (0 until it has)
+                # the biases, scale factors and misalignments the filter
+                # estimated, compensated (0 until it has)
                 dtheta_c = nav_filter.compensate_gyro(self.nav, dtheta_p, self.dt)
                 dv_sf_n = strapdown.update(self.sd, dtheta_c, dv_p - self.nav.accel_bias * self.dt, self.dt)
                 self.nav_tick(dv_sf_n, dtheta_c)

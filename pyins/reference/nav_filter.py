@@ -3,9 +3,10 @@ beside the strapdown in NAVIGATE, 19 states, for the IMU frame p.
 
 Mirrors ``csrc/src/nav_filter.{hpp,cpp}``; the header gives the model
 (X = [phi, dv_E, dv_N, dp_E, dp_N, eps_p, nabla_x, nabla_y, m_xz, m_yz, k_z,
-k_x, k_y, m_xy, m_yx], Yan 2019 eqs. 4.2.26-4.2.33 with the ship's velocity;
-the gyros' scale factors and misalignments act through the rates), the time update by blocks (the
-constants' rows of F are zero), the gate (the joint NIS of a pair,
+k_x, k_y, m_xy, m_yx], Yan 2019 eqs. 4.2.26-4.2.33 with the ship's
+velocity; the gyros' scale factors and misalignments act through the
+rates), the time update by blocks (the constants' rows of F are zero), the
+gate (the joint NIS of a pair,
 chi-square with 2 degrees of freedom) and the feedback.
 """
 from dataclasses import dataclass, field
