@@ -36,7 +36,16 @@ NAMES = {"tick_hz": "--rate", "lat_rad": "--lat", "lon_rad": "--lon", "height_m"
          "coarse_output_every_ticks": "--coarse-every", "coarse_method": "--coarse-method",
          "fine_ticks": "--fine", "fine_states": "--fine-states",
          "fine_gyro_arw": "--gyro-arw", "fine_accel_vrw": "--accel-vrw",
-         "fine_sigma0_att_rad": "--fine-sigma0"}
+         "fine_sigma0_att_rad": "--fine-sigma0", "nav_gyro_bias_rw": "--nav-gyro-bias-rw",
+         "nav_table_scale_sigma": "--nav-table-scale", "nav_table_mis_sigma": "--nav-table-mis",
+         "nav_level_scale_sigma": "--nav-level-scale", "nav_level_mis_sigma": "--nav-level-mis"}
+
+#: The navigation filter's model of the IMU: option, the scenario key that
+#: bounds it (the same refusal either way), and 0 means what it means there
+#: ("not modelled"), not a default
+NAV_MODEL = (("--nav-gyro-bias-rw", "nav_gyro_bias_rw"), ("--nav-table-scale", "nav_table_scale_sigma"),
+             ("--nav-table-mis", "nav_table_mis_sigma"), ("--nav-level-scale", "nav_level_scale_sigma"),
+             ("--nav-level-mis", "nav_level_mis_sigma"))
 
 
 def rate_hz(args, data, spec):
@@ -183,6 +192,10 @@ def config(args, data, spec, cfg, say=print):
         cfg["fine_gyro_arw"] = limited("--gyro-arw", args.gyro_arw, "fine_gyro_arw")
     if args.accel_vrw is not None:
         cfg["fine_accel_vrw"] = limited("--accel-vrw", args.accel_vrw, "fine_accel_vrw")
+    for option, key in NAV_MODEL:
+        text = getattr(args, option[2:].replace("-", "_"), None)
+        if text is not None:
+            cfg[key] = limited(option, text, key)
 
     # 4. what the firmware cannot be right without, refused before it runs
     if "lat_rad" not in cfg:

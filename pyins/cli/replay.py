@@ -71,6 +71,19 @@ def add_replay(cmd):
                    help="the static fine filters' R: measured (default: the larger of --accel-vrw and the "
                         "noise the coarse phase measures, vibration included) or configured (--accel-vrw alone)")
     p.add_argument("--vertical", choices=("hold", "free"), help="vertical channel (default hold)")
+    nav = ("the navigation filter's prior sigma of ", " (a state of the filter; with units; 0 or left out: not "
+                                                      "modelled; docs/concepts.md, \"At sea\")")
+    p.add_argument("--nav-table-scale", metavar="SIGMA",
+                   help=nav[0] + "the z gyro's scale factor, e.g. \"10 ppm\"" + nav[1])
+    p.add_argument("--nav-table-mis", metavar="SIGMA",
+                   help=nav[0] + "the x and y gyros' misalignments to the table's axis, e.g. \"10 arcsec\"" + nav[1])
+    p.add_argument("--nav-level-scale", metavar="SIGMA",
+                   help=nav[0] + "the x and y gyros' scale factors, e.g. \"10 ppm\"" + nav[1])
+    p.add_argument("--nav-level-mis", metavar="SIGMA",
+                   help=nav[0] + "the x and y gyros' misalignments to each other, e.g. \"10 arcsec\"" + nav[1])
+    p.add_argument("--nav-gyro-bias-rw", metavar="DENSITY",
+                   help="the navigation filter's gyro bias random walk, their instability, e.g. "
+                        "\"0.0007 deg/h/sqrt(h)\" (0 or left out: random constants)")
     p.add_argument("--every", type=int, help="record every N samples (default: one a second)")
     p.add_argument("--reference", choices=replay.REFERENCES,
                    help="errors against: parked = the site (--lat/--lon/--height) and zero velocity")
