@@ -182,6 +182,8 @@ def main():
     args = ap.parse_args()
     if args.workers < 1:
         ap.error("--workers: at least 1")
+    if not args.hours * 3600.0 > 600.0:
+        ap.error(f"--hours {args.hours:g}: more than 10 min (the NEES is averaged after the first 10 min)")
     n = int(round(args.hours * 3600.0 / DT))
     t0 = time.perf_counter()
     heads, hors, errs, herrs = [], [], [], []
