@@ -162,7 +162,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
     ap.add_argument("--hours", type=float, default=2.0)
-    ap.add_argument("--errors", choices=("model", "seed002", "seed002-draws", "seed002-draws-modelled"), default="model")
+    ap.add_argument("--errors", choices=("model", "seed002", "seed002-draws", "seed002-draws-modelled"),
+                    default="model")
     ap.add_argument("--prior", choices=tuple(PRIORS), default="default",
                     help="the bias sigmas the filter is told (seed002: its grade)")
     ap.add_argument("--bias", type=float, default=0.0, help="GNSS Gauss-Markov bias sigma [m]")
