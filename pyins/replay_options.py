@@ -30,22 +30,20 @@ class OptionError(ValueError):
     """A replay option the firmware cannot be right with: one line for the user."""
 
 
+#: The navigation filter's model of the IMU: the field (and the scenario key
+#: that bounds it: the same refusal either way) and its option; 0 means what
+#: it means there ("not modelled"), not a default
+NAV_MODEL = {"nav_gyro_bias_rw": "--nav-gyro-bias-rw", "nav_table_scale_sigma": "--nav-table-scale",
+             "nav_table_mis_sigma": "--nav-table-mis", "nav_level_scale_sigma": "--nav-level-scale",
+             "nav_level_mis_sigma": "--nav-level-mis"}
+
 #: How the replay command names the firmware fields it sets (`pyins.limits`).
 NAMES = {"tick_hz": "--rate", "lat_rad": "--lat", "lon_rad": "--lon", "height_m": "--height",
          "euler_b_rad": "--attitude", "coarse_ticks": "--coarse",
          "coarse_output_every_ticks": "--coarse-every", "coarse_method": "--coarse-method",
          "fine_ticks": "--fine", "fine_states": "--fine-states",
          "fine_gyro_arw": "--gyro-arw", "fine_accel_vrw": "--accel-vrw",
-         "fine_sigma0_att_rad": "--fine-sigma0", "nav_gyro_bias_rw": "--nav-gyro-bias-rw",
-         "nav_table_scale_sigma": "--nav-table-scale", "nav_table_mis_sigma": "--nav-table-mis",
-         "nav_level_scale_sigma": "--nav-level-scale", "nav_level_mis_sigma": "--nav-level-mis"}
-
-#: The navigation filter's model of the IMU: option, the scenario key that
-#: bounds it (the same refusal either way), and 0 means what it means there
-#: ("not modelled"), not a default
-NAV_MODEL = (("--nav-gyro-bias-rw", "nav_gyro_bias_rw"), ("--nav-table-scale", "nav_table_scale_sigma"),
-             ("--nav-table-mis", "nav_table_mis_sigma"), ("--nav-level-scale", "nav_level_scale_sigma"),
-             ("--nav-level-mis", "nav_level_mis_sigma"))
+         "fine_sigma0_att_rad": "--fine-sigma0", **NAV_MODEL}
 
 
 def rate_hz(args, data, spec):
@@ -192,7 +190,7 @@ def config(args, data, spec, cfg, say=print):
         cfg["fine_gyro_arw"] = limited("--gyro-arw", args.gyro_arw, "fine_gyro_arw")
     if args.accel_vrw is not None:
         cfg["fine_accel_vrw"] = limited("--accel-vrw", args.accel_vrw, "fine_accel_vrw")
-    for option, key in NAV_MODEL:
+    for key, option in NAV_MODEL.items():
         text = getattr(args, option[2:].replace("-", "_"), None)
         if text is not None:
             cfg[key] = limited(option, text, key)
