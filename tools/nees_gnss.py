@@ -90,6 +90,44 @@ def modelled_only(sens):
     return replace(sens, gyro_misalignment=g_mis, accel_scale=np.zeros(3), accel_misalignment=np.zeros((3, 3)))
 
 
+def filter_config(motion, prior="default", table=(0.0, 0.0), bias_rw=0.0, level=(0.0, 0.0), phi=None, dv=None,
+                  dp=None):
+    """The firmware's configuration of one run: the initial state with the
+    errors ``phi`` [rad, E N U], ``dv`` [m/s, E N], ``dp`` [m, E N] (None:
+    0), the filter told ``prior``'s grade and the error-state priors
+    (``table``, ``level``: (scale [ppm], misalignment [arcsec]))."""
+    gyro_prior, accel_prior, arw, vrw = PRIORS[prior]
+    phi = np.zeros(3) if phi is None else phi
+    dv = np.zeros(2) if dv is None else dv
+    dp = np.zeros(2) if dp is None else dp
+    cfg = dict(initial_errors(motion, phi=phi, velocity=[dv[0], dv[1], 0.0], north=dp[1], east=dp[0]),
+               fine_sigma0_att_rad=SIGMA0_ATT)
+    if prior != "default":
+        cfg.update(fine_sigma0_gyro=gyro_prior, fine_sigma0_accel=accel_prior, fine_gyro_arw=arw,
+                   fine_accel_vrw=vrw)
+    cfg.update(nav_table_scale_sigma=table[0] * 1e-6, nav_table_mis_sigma=table[1] * ARCMIN_TO_RAD / 60.0,
+               nav_level_scale_sigma=level[0] * 1e-6, nav_level_mis_sigma=level[1] * ARCMIN_TO_RAD / 60.0)
+    cfg.update(nav_gyro_bias_rw=bias_rw * DEG_TO_RAD / 3600.0 / 60.0)
+    return cfg
+
+
+def fly(motion, n, sens, seed, cfg, refs, avail_tick, indexing):
+    """Navigate ``n`` ticks of ``motion`` with the sensor errors ``sens``
+    (noise from ``seed``) and the GNSS ``refs``: returns (time [s], heading
+    error [rad], the filter's heading sigma [rad], horizontal error [m],
+    the filter's horizontal sigma [m]) at every record (1 s)."""
+    if indexing:
+        res = fil.run_fil(motion, n, config=dict(cfg, index_scheme=2), errors=sens, seed=seed, every=100,
+                          refs=refs, avail_tick=avail_tick)
+    else:
+        res = navigate(motion, n, every=100, sensors=sim.SensorModel(sens, seed=seed), config=cfg, refs=refs,
+                       avail_tick=avail_tick)
+    e = metrics.nav_errors(res)
+    o = res.outputs
+    return (e.time_s, e.att_n_rad[:, 2], o["nav_sigma_heading_rad"], np.hypot(e.east_m, e.north_m),
+            o["nav_sigma_pos_m"])
+
+
 def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0, 0.0), bias_rw=0.0,
             level=(0.0, 0.0)):
     gyro_prior, accel_prior, arw, vrw = PRIORS[prior]
@@ -109,27 +147,12 @@ def one_run(motion, n, seed, errors, bias, indexing, prior="default", table=(0.0
     phi = rng.normal(0.0, 1.0, 3) * SIGMA0_ATT
     dv = rng.normal(0.0, SIGMA0_VEL, 2)
     dp = rng.normal(0.0, SIGMA0_POS, 2)
-    cfg = dict(initial_errors(motion, phi=phi, velocity=[dv[0], dv[1], 0.0], north=dp[1], east=dp[0]),
-               fine_sigma0_att_rad=SIGMA0_ATT)
-    if prior != "default":
-        cfg.update(fine_sigma0_gyro=gyro_prior, fine_sigma0_accel=accel_prior, fine_gyro_arw=arw,
-                   fine_accel_vrw=vrw)
-    cfg.update(nav_table_scale_sigma=table[0] * 1e-6, nav_table_mis_sigma=table[1] * ARCMIN_TO_RAD / 60.0,
-               nav_level_scale_sigma=level[0] * 1e-6, nav_level_mis_sigma=level[1] * ARCMIN_TO_RAD / 60.0)
-    cfg.update(nav_gyro_bias_rw=bias_rw * DEG_TO_RAD / 3600.0 / 60.0)
+    cfg = filter_config(motion, prior, table, bias_rw, level, phi, dv, dp)
     g = references.gnss(motion, n * DT, seed=2000 + seed, bias_sigma_m=bias)
-    refs = g.refs.astype(contract.REF_DTYPE)
-    if indexing:
-        res = fil.run_fil(motion, n, config=dict(cfg, index_scheme=2), errors=sens, seed=seed, every=100,
-                          refs=refs, avail_tick=g.avail_tick)
-    else:
-        res = navigate(motion, n, every=100, sensors=sim.SensorModel(sens, seed=seed), config=cfg, refs=refs,
-                       avail_tick=g.avail_tick)
-    e = metrics.nav_errors(res)
-    o = res.outputs
-    head = (e.att_n_rad[:, 2] / o["nav_sigma_heading_rad"]) ** 2
-    hor = (e.north_m ** 2 + e.east_m ** 2) / o["nav_sigma_pos_m"] ** 2
-    return e.time_s, head, hor, e.att_n_rad[:, 2], np.hypot(e.east_m, e.north_m)
+    t, head_err, head_sig, hor_err, hor_sig = fly(motion, n, sens, seed, cfg, g.refs.astype(contract.REF_DTYPE),
+                                                  g.avail_tick, indexing)
+    # the horizontal sigma's square is P_EE + P_NN (the record's nav_sigma_pos_m)
+    return t, (head_err / head_sig) ** 2, hor_err ** 2 / hor_sig ** 2, head_err, hor_err
 
 
 _MOTIONS = {}

@@ -205,13 +205,9 @@ def test_the_nees_tool_splits_the_errors_the_filter_models_from_those_it_leaves_
     002's production with only what the 19 states carry: the biases, the
     gyros' scale factors and the misalignments of the x and y gyros kept
     as drawn, the rest 0."""
-    import importlib.util
-    import pathlib
     from pyins.sim.sensors import draw_random_constants
-    path = pathlib.Path(__file__).resolve().parents[2] / "tools" / "nees_gnss.py"
-    spec = importlib.util.spec_from_file_location("nees_gnss", path)
-    tool = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(tool)
+    from tools_loader import load_tool
+    tool = load_tool("nees_gnss.py")
     full = draw_random_constants("seed002", 10)
     cut = tool.modelled_only(full)
     for kept in ("gyro_bias", "gyro_scale", "accel_bias", "gyro_arw", "accel_vrw"):
@@ -254,3 +250,40 @@ def test_a_y_accelerometer_misaligned_to_x_reads_a_turn_as_a_heading_error_does(
     assert np.linalg.norm(want) > 5e-3        # the turn is in the window
     assert np.linalg.norm(dv - want) <= 0.10 * np.linalg.norm(want)
     assert np.dot(dv, want) >= np.cos(np.radians(3.0)) * np.linalg.norm(dv) * np.linalg.norm(want)
+
+
+def test_the_error_budget_weights_its_terms_as_a_unit_draws_them():
+    """tools/nav_error_budget.py sums the heading errors of seed 002's terms,
+    each run alone at its +1 sigma, weighted with a unit's normals: that
+    sum is the unit's own error only if each term's run holds what the
+    draw puts there. Summed the same way, the terms' error sets give unit
+    12's random constants exactly (every one: the draws are exact
+    multiples of the sigmas), and the budget's split into what the 19
+    states carry is the nees tool's modelled_only."""
+    from dataclasses import fields
+    from pyins.sim.sensors import draw_random_constants, random_constant_normals
+    from tools_loader import load_tool
+    tool = load_tool("nav_error_budget.py")
+    nees = load_tool("nees_gnss.py")
+    unit = draw_random_constants("seed002", 12)
+    z = random_constant_normals(12)
+    constants = ("gyro_bias", "gyro_scale", "gyro_misalignment", "accel_bias", "accel_scale",
+                 "accel_misalignment")
+    total = {name: np.zeros_like(getattr(unit, name)) for name in constants}
+    modelled = {name: np.zeros_like(getattr(unit, name)) for name in constants}
+    for _, field, idx, carried in tool.TERMS:
+        one = tool._term_errors(field, idx)
+        for name in constants:
+            total[name] += tool._normal_of(field, idx, z) * getattr(one, name)
+            if carried:
+                modelled[name] += tool._normal_of(field, idx, z) * getattr(one, name)
+    cut = nees.modelled_only(unit)
+    for name in constants:
+        assert np.allclose(total[name], getattr(unit, name), rtol=1e-12, atol=0.0), name
+        # the accelerometers' z bias is not a state (the vertical is held) but modelled_only keeps it
+        want = getattr(cut, name).copy()
+        if name == "accel_bias":
+            want[2] = 0.0
+        assert np.allclose(modelled[name], want, rtol=1e-12, atol=0.0), name
+    assert len(tool.TERMS) == sum(np.count_nonzero(getattr(sim.preset("seed002"), f.name))
+                                  for f in fields(unit) if f.name in constants)

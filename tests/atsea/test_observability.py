@@ -17,20 +17,16 @@ is off by -g (m_xz, m_yz), the two gyro misalignments a rotation about z
 turns into a tilt of the IMU frame (predicted from the sensor errors, not
 written here). Measured on 2026-12-05: the figures are in the comments.
 """
-import importlib.util
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pyins.reference import nav_filter
 from pyins.units import DT
+from tools_loader import load_tool
 
-_spec = importlib.util.spec_from_file_location(
-    "observability_nav", Path(__file__).resolve().parents[2] / "tools" / "observability_nav.py")
-ob = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(ob)
+ob = load_tool("observability_nav.py")
 
 HOURS = 2.0                          # the covariance analysis (0.6 s an hour a case)
 FW_HOURS = 0.5                       # the firmware runs (the 100-Hz voyage's track: ~5 s an hour)

@@ -5,10 +5,8 @@ campaign with ``random_constants`` gives every scheme of one draw the same
 constants (paired) and a new draw new ones; its mistakes are one line; the
 small Monte-Carlo campaign gives identical aggregates locally and on a Dask
 LocalCluster; the report's statistics (percentile, Clopper-Pearson)."""
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,15 +15,12 @@ from pyins import campaign, scenario
 from pyins.scenario import ScenarioError
 from pyins.sim import sensors
 from pyins.units import ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
+from tools_loader import load_tool
 
-TOOLS = Path(__file__).resolve().parents[2] / "tools" / "papers"
 
 
 def _driver():
-    spec = importlib.util.spec_from_file_location("montecarlo_driver", TOOLS / "montecarlo.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_tool("papers/montecarlo.py")
 
 
 # ---------------------------------------------------------------------------

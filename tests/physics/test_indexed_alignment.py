@@ -4,23 +4,18 @@ navigation filter aided by zero velocity with the table indexed between two
 positions, against the static limit eps_E / (Omega cos L) of each draw of
 seed 000's errors; and the same filter with the table fixed, which cannot
 beat it (the indexing is what separates the drift from the heading)."""
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
 
 from pyins.units import ARCMIN_TO_RAD
+from tools_loader import load_tool
 
-ROOT = Path(__file__).resolve().parents[2]
 DRAWS = range(12)           # two of each heading 0, 60, ... 300 deg
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("indexed_alignment", ROOT / "tools" / "indexed_alignment.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("indexed_alignment.py")
 
 
 def test_indexing_beats_the_static_limit():
@@ -87,8 +82,6 @@ def test_the_mirror_aligns_alike():
     identical (modes, indexing, references used and rejected), the floats
     within tests/engines.py's bounds (the NIS of the pier's zero velocity,
     0.001 m/s, to 1e-6 absolute: engines.py says why)."""
-    import sys
-    sys.path.insert(0, str(ROOT / "tests"))
     from engines import assert_engines_agree
     from pyins import scenario
     from pyins.run_scenario import run

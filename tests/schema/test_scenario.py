@@ -1,6 +1,5 @@
 """Scenario files: built-ins, units, the resolved form and its digest,
 overrides, one clear line per mistake, and a short run through the firmware."""
-import importlib.util
 import json
 import math
 from dataclasses import fields
@@ -16,6 +15,7 @@ from pyins.reference import attitude
 from pyins.scenario import ScenarioError
 from pyins.units import UNITS, parse_quantity
 from pyins import units
+from tools_loader import load_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 DEG = units.DEG_TO_RAD
@@ -28,11 +28,8 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
 
 
 def _tool(name):
-    """tools/<name>.py as a module (the scripts that reproduce the papers)."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / "papers" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """tools/papers/<name>.py as a module (the scripts that reproduce the papers)."""
+    return load_tool(f"papers/{name}.py")
 
 
 # Seed 002 as the paper sets it up (Table 1 initial errors, the schemes, the constant-rate turns),

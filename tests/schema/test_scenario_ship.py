@@ -3,7 +3,6 @@ wave spectrum) and lever arms in [motion], firmware.lever and
 firmware.coarse_method; the moored built-ins against pyins.sim.moored and
 tools/papers/moored_alignment.py; files without these keys unchanged (motion and
 digest); one clear line per mistake; a short run through the firmware."""
-import importlib.util
 from dataclasses import fields
 from pathlib import Path
 
@@ -14,6 +13,7 @@ from pyins import run_scenario, scenario, sim
 from pyins.reference import earth
 from pyins.scenario import ScenarioError
 from pyins import units
+from tools_loader import load_tool
 
 ROOT = Path(__file__).resolve().parents[2]
 DEG = units.DEG_TO_RAD
@@ -24,10 +24,7 @@ SEEDS_PAPERS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "see
 
 
 def _tool(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / "papers" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_tool(f"papers/{name}.py")
 
 
 def assert_same_ship(a, b):
