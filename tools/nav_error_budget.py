@@ -3,8 +3,8 @@
 each of seed 002's error terms, alone at its +1 sigma, leaves in the
 heading, against the filter's own heading sigma.
 
-    .venv/bin/python tools/nav_error_budget.py [--hours 24] [--noise-seeds 4] [--workers 1]
-                                               [--only "gyro mis m_xy" ...] [--check-draw D]
+    .venv/bin/python tools/nav_error_budget.py [--hours 24] [--noise-seeds 4] [--noise-first 0]
+                                               [--workers 1] [--only "gyro mis m_xy" ...] [--check-draw D]
                                                [--save runs/budget.npz]
 
 The voyage, the indexing and the filter's settings are tools/nees_gnss.py's
@@ -149,6 +149,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hours", type=float, default=24.0)
     ap.add_argument("--noise-seeds", type=int, default=4)
+    ap.add_argument("--noise-first", type=int, default=0, help="the first noise seed (more seeds in another run)")
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--check-draw", type=int, default=None)
     ap.add_argument("--only", nargs="+", default=None, metavar="TERM",
@@ -165,14 +166,16 @@ def main():
             ap.error("--check-draw needs every term (the unit's error is their sum): not with --only")
         terms_run = [x for x in TERMS if x[0] in args.only]
         initial_run = [x for x in INITIAL if x[0] in args.only]
-    if args.workers < 1 or args.noise_seeds < 1:
-        ap.error("--workers and --noise-seeds: at least 1")
+    if args.workers < 1 or args.noise_seeds < 1 or args.noise_first < 0:
+        ap.error("--workers and --noise-seeds: at least 1; --noise-first: at least 0")
+    noise_seeds = range(args.noise_first, args.noise_first + args.noise_seeds)
     if not args.hours * 3600.0 > 600.0:
         ap.error(f"--hours {args.hours:g}: more than 10 min")
     jobs = ([(args.hours, "term", (f, i)) for _, f, i, _ in terms_run]
             + [(args.hours, "initial", (f, i)) for _, f, i in initial_run]
-            + [(args.hours, "noise", s) for s in range(args.noise_seeds)])
-    names = [t[0] for t in terms_run] + [t[0] for t in initial_run] + [f"noise seed {s}" for s in range(args.noise_seeds)]
+            + [(args.hours, "noise", s) for s in noise_seeds])
+    names = ([t[0] for t in terms_run] + [t[0] for t in initial_run]
+             + [f"noise seed {s}" for s in noise_seeds])
     if args.check_draw is not None:
         jobs.append((args.hours, "draw", args.check_draw))
         names.append(f"unit {args.check_draw}")

@@ -22,8 +22,8 @@
 // Choices the paper leaves open (docs/indexing.md):
 // - "opposite sign" takes zero as either sign (sin psi * A_s <= 0);
 // - no heading satisfying the condition within `max_flex` of turning (e.g.
-//   |A_c/N_p| > 1 + delta): the table stops after max_flex (default one
-//   turn) and the fallback is counted;
+//   |A_c/N_p| > 1 + delta): the table stops after max_flex (default two
+//   turns, 720 deg: the ship may turn back) and the fallback is counted;
 // - the commanded motion is a trapezoidal rate profile (rate, accel); a
 //   flexible stop decelerates from the tick the condition holds, so the table
 //   stops v^2/(2 accel) further on (0.6 deg at 6 deg/s and 30 deg/s^2);
