@@ -128,9 +128,11 @@ def explain(r, hours):
                   "it), so the draw of the paper's random-constant drifts decides much.",
                   f"- **Heading-correlated errors**: the scale-factor and installation errors alone "
                   f"give {sfm[0]:.2f} / {sfm[1]:.2f} / {sfm[2]:.2f} / {sfm[3]:.2f} / {sfm[4]:.2f} nmi. "
-                  "Times the "
-                  "6 deg/s heading swing and the table rate they act like drifts that move with "
-                  "the heading; no scheme is designed against them.",
+                  "They turn the rates the gyros see (the 6 deg/s heading swing, the table's "
+                  "turns) into drift, and on the tilted deck, where the table turns in step with "
+                  "the swing, into a mean up drift that a vertical-axis table cannot modulate "
+                  "(\"The gyro misalignment times the deck's tilt\" below); no scheme is "
+                  "designed against them.",
                   f"- **Horizontal drifts only** (the effect the paper's analysis is about): max "
                   f"{hd[0]:.3f} / {hd[1]:.3f} / {hd[2]:.3f} / {hd[3]:.3f} / {hd[4]:.3f} nmi; the "
                   f"fraction of a constant x/y drift that survives (the proxy of docs/papers.md, "
