@@ -43,6 +43,7 @@ import concurrent.futures
 import os
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -50,7 +51,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import nees_gnss  # noqa: E402  (the acceptance run's settings and one run of it)
 from pyins import contract, sim  # noqa: E402
 from pyins.sim import references  # noqa: E402
-from pyins.sim.sensors import PRESETS, random_constant_normals  # noqa: E402
+from pyins.sim.sensors import PRESETS, RANDOM_CONSTANT_TERMS, random_constant_normals  # noqa: E402
 from pyins.units import ARCMIN_TO_RAD, DT  # noqa: E402
 
 ARCSEC = ARCMIN_TO_RAD / 60.0
@@ -70,9 +71,10 @@ TERMS = ([(f"gyro bias {a}", "gyro_bias", i, True) for i, a in enumerate(_XYZ)]
 INITIAL = ([(f"initial phi_{a}", "phi", i) for i, a in enumerate("ENU")]
            + [(f"initial dv_{a}", "dv", i) for i, a in enumerate("EN")]
            + [(f"initial dp_{a}", "dp", i) for i, a in enumerate("EN")])
-# The random constants' order in random_constant_normals: bias, scale, misalignment (row by row), per triad.
-_NORMAL_INDEX = {"gyro_bias": 0, "gyro_scale": 3, "gyro_misalignment": 6, "accel_bias": 15, "accel_scale": 18,
-                 "accel_misalignment": 21}
+# Where each field's normals start in random_constant_normals (its fields in RANDOM_CONSTANT_TERMS' order,
+# a matrix row by row).
+_NORMAL_INDEX = {term: int(sum(np.size(getattr(sim.SensorErrors(), t)) for t, _, _ in RANDOM_CONSTANT_TERMS[:k]))
+                 for k, (term, _, _) in enumerate(RANDOM_CONSTANT_TERMS)}
 
 
 def _normal_of(field, idx, z):
@@ -83,22 +85,14 @@ def _normal_of(field, idx, z):
 
 def _quiet(sens):
     """``sens`` without its white noise."""
-    from dataclasses import replace
     return replace(sens, gyro_arw=0.0, accel_vrw=0.0)
-
-
-def _zero_errors():
-    z3, m3 = np.zeros(3), np.zeros((3, 3))
-    return sim.SensorErrors(gyro_bias=z3, gyro_scale=z3, gyro_misalignment=m3, accel_bias=z3, accel_scale=z3,
-                            accel_misalignment=m3)
 
 
 def _term_errors(field, idx):
     """No error but seed 002's +1 sigma of (field, idx)."""
-    sens = _zero_errors()
+    sens = sim.SensorErrors()
     v = getattr(sens, field).copy()
     v[idx] = abs(getattr(PRESETS["seed002"], field)[idx])
-    from dataclasses import replace
     return replace(sens, **{field: v})
 
 
@@ -131,12 +125,11 @@ def _run(job):
         field, i = spec
         init[field][i] = {"phi": nees_gnss.SIGMA0_ATT[i], "dv": nees_gnss.SIGMA0_VEL,
                           "dp": nees_gnss.SIGMA0_POS}[field]
-        sens = _zero_errors()
+        sens = sim.SensorErrors()
     elif kind == "noise":
         seed = spec
         p = PRESETS["seed002"]
-        from dataclasses import replace
-        sens = replace(_zero_errors(), gyro_arw=p.gyro_arw, accel_vrw=p.accel_vrw)
+        sens = sim.SensorErrors(gyro_arw=p.gyro_arw, accel_vrw=p.accel_vrw)
     else:  # "draw": a whole unit, no noise
         sens = _quiet(sim.sensors.draw_random_constants("seed002", spec))
     cfg = nees_gnss.filter_config(motion, "seed002", TABLE, 0.0, LEVEL, init["phi"], init["dv"], init["dp"])
