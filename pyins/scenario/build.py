@@ -26,8 +26,9 @@ _SHIP_RESOLVED = ("heave", "surge", "sway", "spectrum", "lever_b_m", "lever_p_m"
 
 
 def _is_ship(m):
-    """True when a resolved [motion] has any ship key (a pyins.sim.ShipAtSea)."""
-    return any(k in m for k in _SHIP_RESOLVED)
+    """True when a resolved [motion] is a pyins.sim.ShipAtSea: any ship key,
+    or a ship at anchor."""
+    return m.get("kind") == "at_anchor" or any(k in m for k in _SHIP_RESOLVED)
 
 
 def _build_motion(m):
@@ -42,6 +43,12 @@ def _build_motion(m):
     elif any(a in m for a in _LINEAR_AXES):
         linear = sim.LinearMotion(**{a: [(c["amplitude_m"], c["period_s"], c["phase_rad"])
                                          for c in m.get(a, [])] for a in _LINEAR_AXES})
+    if m["kind"] == "at_anchor":      # the arc about the anchor, with the waves' heave, surge and sway on it
+        surge, sway = sim.anchor_linear(m["radius_m"], m["swing_period_s"], m["swing_angle_rad"],
+                                        m["swing_phase_rad"])
+        waves = linear if linear is not None else sim.LinearMotion()
+        linear = sim.LinearMotion(heave=waves.heave, surge=tuple(surge) + tuple(waves.surge),
+                                  sway=tuple(sway) + tuple(waves.sway))
     return sim.ShipAtSea(base, linear, lever_b=m.get("lever_b_m", (0.0, 0.0, 0.0)),
                          lever_p=m.get("lever_p_m", (0.0, 0.0, 0.0)))
 
@@ -58,6 +65,9 @@ def _build_base_motion(m):
     if kind == "sea_state":
         return sim.sea_state(m["sea_state"], lat, lon, h, m["yaw_rad"], m["pitch_rad"], m["roll_rad"],
                              m["phase_rad"])
+    if kind == "at_anchor":
+        return sim.anchor_swing(m["sea_state"], lat, lon, h, m["yaw_rad"], m["swing_period_s"],
+                                m["swing_angle_rad"], m["swing_phase_rad"], m["pitch_rad"], m["roll_rad"])
     if kind == "heading_swing":
         return sim.HeadingSwing(lat, lon, h, m["pitch_rad"], m["roll_rad"], m["yaw_rad"],
                                 m["rate_amplitude_rad_s"], m["period_s"])

@@ -68,7 +68,7 @@ TABLE_NAMES = ("motion", "sensors", "turntable", "indexing", "firmware", "initia
 _LAT_DEFAULT, _LON_DEFAULT = "34.246 deg", "108.910 deg"
 MOTION_COMMON = {
     "kind": Key("choice", "motion profile", required=True,
-                choices=("static", "swing", "sea_state", "heading_swing", "manoeuvre", "voyage")),
+                choices=("static", "swing", "sea_state", "heading_swing", "at_anchor", "manoeuvre", "voyage")),
     "lat": _angle("geodetic latitude", _LAT_DEFAULT, "-89.9 deg", "89.9 deg"),
     "lon": _angle("longitude", _LON_DEFAULT, "-360 deg", "360 deg"),
     "height": Key("length", "height above the WGS-84 ellipsoid", "0 m", lo="-10 km", hi="100 km"),
@@ -101,6 +101,17 @@ MOTION_KINDS = {
                               lo="0 deg/s", hi="100 deg/s", lo_open=True),
         "period": Key("time", "period T", lo="0 s", hi="1 d", lo_open=True),
     },
+    "at_anchor": {
+        "sea_state": Key("choice", "sea state of seed 000 Table 2: its pitch and roll (the yaw is the "
+                                   "swing's)", required=True, choices=tuple(sim.SEA_STATES)),
+        "radius": Key("length", "the anchor -> the motion reference point: the arc's radius", "50 m",
+                      lo="0 m", hi="1000 m"),
+        "swing_period": Key("time", "period of the swing about the anchor", "40 min", lo="0 s", hi="1 d",
+                            lo_open=True),
+        "swing_angle": _angle("half angle of the swing (the chain's angle from the mean bow; the bow "
+                              "follows it)", "30 deg", "0 deg", "90 deg"),
+        "swing_phase": _angle("phase of the swing at t = 0", "0 deg", "-360 deg", "360 deg"),
+    },
     "manoeuvre": {
         "speed": Key("velocity", "initial speed", "0 m/s", lo="0 m/s", hi="100 m/s"),
         "segments": Key("tables", "'default' (the 30-min manoeuvre) or legs "
@@ -129,8 +140,8 @@ SEGMENT_KEYS = {
     "angle": _angle("yaw change, counter-clockwise (turn)", None, "-3600 deg", "3600 deg"),
 }
 
-#: Keys of the fixed-position kinds (static, swing, sea_state, heading_swing)
-#: that make the ship a `pyins.sim.ShipAtSea`: heave, surge and sway of the
+#: Keys of the fixed-position kinds (static, swing, sea_state, heading_swing,
+#: at_anchor: its mean position is fixed) that make the ship a `pyins.sim.ShipAtSea`: heave, surge and sway of the
 #: motion reference point (sinusoids or a wave spectrum) and the lever arms.
 #: Any of them present: a ShipAtSea; none: the base profile itself.
 SHIP_KEYS = {
@@ -168,7 +179,7 @@ SPECTRUM_KEYS = {
                 lo=0),
     "components": Key("int", "sinusoids per axis", default=40, lo=1, hi=1000),
 }
-_FIXED_KINDS = ("static", "swing", "sea_state", "heading_swing")
+_FIXED_KINDS = ("static", "swing", "sea_state", "heading_swing", "at_anchor")
 _LINEAR_AXES = ("heave", "surge", "sway")
 for _kind in _FIXED_KINDS:
     MOTION_KINDS[_kind].update(SHIP_KEYS)

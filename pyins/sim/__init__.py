@@ -9,7 +9,7 @@ errors, files. One room per concept:
 - `pyins.sim.ship`: the sea around a real ship at the pier: heave, surge and
   sway (`LinearMotion`), lever arms (`ShipAtSea`), wave spectra
   (`sea_spectrum_motion`, `SEA_STATE_SPECTRA`) and the built-in moored ship
-  (`moored`, `MOORED_SHIP`).
+  (`moored`, `MOORED_SHIP`), and a ship swinging at anchor (`at_anchor`).
 - `pyins.sim.voyage`: a ship under way at sea (`Voyage`: a `Manoeuvre`
   track with the heel of its turns, the sea-state swing and heave;
   `default_voyage`, a multi-hour transit).
@@ -42,8 +42,8 @@ from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, 
 from pyins.sim.motion import (SEA_STATES, HeadingSwing, Manoeuvre, Motion, MotionState, Segment,
                               Static, Swing, default_segments, periodic_ticks, sea_state)
 from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
-from pyins.sim.ship import (MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, dnv_gamma,
-                            heave_response, jonswap, moored, named_sea_spectrum,
+from pyins.sim.ship import (AT_ANCHOR, MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, anchor_linear,
+                            anchor_swing, at_anchor, dnv_gamma, heave_response, jonswap, moored, named_sea_spectrum,
                             pierson_moskowitz, sea_spectrum_motion)
 from pyins.sim.turntable import ConstantRate, Fixed, TableMotion
 from pyins.sim.voyage import Voyage, default_voyage
@@ -56,6 +56,7 @@ __all__ = [
     "Swing", "default_segments", "sea_state",
     "PRESETS", "SensorErrors", "SensorModel", "preset",
     "Voyage", "default_voyage",
+    "AT_ANCHOR", "anchor_linear", "anchor_swing", "at_anchor",
     "MOORED_SHIP", "SEA_STATE_SPECTRA", "LinearMotion", "ShipAtSea", "dnv_gamma", "heave_response",
     "jonswap", "moored", "named_sea_spectrum", "pierson_moskowitz", "sea_spectrum_motion",
     "ConstantRate", "Fixed", "TableMotion",

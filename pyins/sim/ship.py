@@ -14,6 +14,8 @@ point, both closed form, so `pyins.sim.imu.exact_increments` stays exact).
    `dnv_gamma`, `heave_response`, `sea_spectrum_motion`, `SEA_STATE_SPECTRA`,
    `named_sea_spectrum`.
 4. The built-in moored ship: `MOORED_SHIP`, `moored`.
+5. A ship swinging at anchor: `AT_ANCHOR`, `anchor_linear`, `anchor_swing`,
+   `at_anchor`.
 
 Positions (exact by definition)
 -------------------------------
@@ -606,3 +608,111 @@ def moored(sea_state_name, lat, lon, height, yaw0, pitch0=0.0, roll0=0.0,
     linear = LinearMotion(heave=MOORED_SHIP["heave"], surge=MOORED_SHIP["surge"],
                           sway=MOORED_SHIP["sway"])
     return ShipAtSea(swing, linear, lever_b=MOORED_SHIP["lever_b"], lever_p=lever_p)
+
+
+# ---------------------------------------------------------------------------
+# 5. A ship at anchor
+# ---------------------------------------------------------------------------
+#: The ship at anchor of the built-in scenario `at_anchor` and of
+#: tools/anchor_alignment.py: the chain's radius (the anchor to the motion
+#: reference point) [m], the period of the swing [s] and its half angle
+#: [rad]: tens of metres over tens of minutes.
+AT_ANCHOR = dict(radius=50.0, period=2400.0, swing=30.0 * np.pi / 180.0)
+
+#: Harmonics of the arc kept (`anchor_linear`): the next one, J_7(pi/2),
+#: is 6e-6 of the radius (0.5 mm at 80 m).
+_ARC_HARMONICS = 6
+
+
+def _bessel_j(n, x):
+    """Bessel function of the first kind J_n(x), its power series
+    sum_k (-1)^k (x/2)^(2k+n) / (k! (k+n)!) (Abramowitz & Stegun 9.1.10),
+    to double precision for |x| <= pi / 2 (30 terms; the last is below
+    1e-40)."""
+    term = (x / 2.0) ** n
+    for k in range(1, n + 1):
+        term = term / k
+    total = term
+    for k in range(1, 30):
+        term = -term * (x / 2.0) ** 2 / (k * (k + n))
+        total = total + term
+    return total
+
+
+def anchor_linear(radius, period, swing, phase=0.0):
+    """Sway and surge of a ship's reference point on its arc about the anchor.
+
+    The anchor lies ``radius`` ahead of the mean position along the mean
+    bow; the chain's angle from that line is theta(t) = swing sin(2 pi t /
+    period + phase), and the ship lies on the circle, its bow towards the
+    anchor:
+
+        sway(t)  = -radius sin theta
+        surge(t) =  radius (1 - cos theta)     (towards the anchor)
+
+    Both are Fourier series of sin(x), x = 2 pi t / period + phase (the
+    Jacobi-Anger expansion, Abramowitz & Stegun 9.1.42-43):
+
+        sin(s sin x) = 2 sum_{k odd}  J_k(s) sin(k x)
+        cos(s sin x) = J_0(s) + 2 sum_{k even >= 2} J_k(s) cos(k x)
+
+    kept to the 6th harmonic (the 7th is 0.5 mm at 80 m and 90 deg; with
+    the positions' radii fixed at the site the ship stays within 6 mm of
+    the circle). The
+    constant radius (1 - J_0(s)) is left out: the mean position is the
+    arc's mean. Returns ``(surge, sway)`` as `LinearMotion` components
+    ((amplitude [m], period [s], phase [rad]), ...).
+    """
+    radius, period, swing, phase = float(radius), float(period), float(swing), float(phase)
+    if not (np.isfinite(radius) and 0.0 <= radius <= 1000.0):
+        raise ValueError(f"radius: {radius!r} m, must be within 0..1000 m")
+    if not (np.isfinite(period) and period > 0.0):
+        raise ValueError(f"period: {period!r} s, must be finite and > 0")
+    if not (np.isfinite(swing) and 0.0 <= swing <= np.pi / 2.0):
+        raise ValueError(f"swing: {swing!r} rad, the half angle must be within 0..90 deg")
+    if not np.isfinite(phase):
+        raise ValueError(f"phase: {phase!r} rad, must be finite")
+    sway, surge = [], []
+    for k in range(1, _ARC_HARMONICS + 1):
+        a = 2.0 * radius * _bessel_j(k, swing)
+        if k % 2:       # -radius 2 J_k sin(k x)
+            sway.append((-a, period / k, k * phase))
+        else:           # -radius 2 J_k cos(k x) = -radius 2 J_k sin(k x + pi / 2)
+            surge.append((-a, period / k, k * phase + np.pi / 2.0))
+    return tuple(surge), tuple(sway)
+
+
+def anchor_swing(sea_state_name, lat, lon, height, yaw0, period, swing, phase=0.0, pitch0=0.0, roll0=0.0):
+    """The attitude of a ship at anchor (`at_anchor`): the sea state's pitch
+    and roll, yaw0 - theta(t) with theta(t) = swing sin(2 pi t / period +
+    phase)."""
+    anchor_linear(0.0, period, swing, phase)        # the same checks of period, swing, phase
+    sea = sea_state(sea_state_name, lat, lon, height, yaw0, pitch0, roll0)
+    return Swing(lat, lon, height, pitch0, roll0, yaw0,
+                 [sea.amplitude[0], sea.amplitude[1], float(swing)],
+                 [sea.frequency_hz[0], sea.frequency_hz[1], 1.0 / float(period)],
+                 [0.0, 0.0, float(phase) + np.pi])
+
+
+def at_anchor(sea_state_name, lat, lon, height, yaw0, radius=AT_ANCHOR["radius"],
+              period=AT_ANCHOR["period"], swing=AT_ANCHOR["swing"], phase=0.0, pitch0=0.0, roll0=0.0,
+              heave=MOORED_SHIP["heave"], surge=(), sway=(), lever_b=MOORED_SHIP["lever_b"],
+              lever_p=(0.0, 0.0, 0.0)):
+    """A ship swinging at anchor.
+
+    The reference point goes round the arc of `anchor_linear` (``radius``,
+    ``period``, half angle ``swing``, ``phase``) and the bow follows the
+    chain: yaw(t) = yaw0 - theta(t) (counter-clockwise yaw; the ship turns
+    to starboard while it swings to port), its rate up to swing 2 pi /
+    period (0.08 deg/s at 30 deg and 40 min). Pitch and roll are the sea
+    state's (seed 000 Table 2, `pyins.sim.motion.sea_state`); its yaw is
+    the swing's alone (the waves' few degrees of yaw at 0.2 Hz left out:
+    `Swing` carries one sinusoid per angle). ``heave`` (default the moored
+    ship's 0.5 m at 8 s) and any ``surge``/``sway`` sinusoids add to the
+    arc; ``lever_b`` (default the moored ship's) and ``lever_p`` as
+    `ShipAtSea`. yaw0 is the mean yaw: the mean bow points at the anchor.
+    """
+    base = anchor_swing(sea_state_name, lat, lon, height, yaw0, period, swing, phase, pitch0, roll0)
+    arc_surge, arc_sway = anchor_linear(radius, period, swing, phase)
+    linear = LinearMotion(heave=heave, surge=tuple(arc_surge) + tuple(surge), sway=tuple(arc_sway) + tuple(sway))
+    return ShipAtSea(base, linear, lever_b=lever_b, lever_p=lever_p)

@@ -24,7 +24,8 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
             "moored_bad", "moored_general", "moored_ideal", "moored_spectrum",   # test_scenario_ship.py
             "harbour_ranging",                                                  # test_harbour_ranging.py
             "voyage_gnss", "voyage_gnss_outages", "voyage_log", "voyage_dvl",   # tests/atsea/test_scenario_refs.py
-            "pier_indexed", "moored_indexed"]                                   # tests/physics/test_indexed_alignment.py
+            "pier_indexed", "moored_indexed",                                   # tests/physics/test_indexed_alignment.py
+            "at_anchor"]                                                        # tests/physics/test_anchor_alignment.py
 
 
 def _tool(name):

@@ -101,6 +101,41 @@ def test_moored_spectrum_builtin_is_the_preset_sea():
         assert np.array_equal(r.motion.base.state(t).euler, general.motion.base.state(t).euler)
 
 
+def test_at_anchor_builtin_is_sim_at_anchor_with_the_moored_ships_heave_and_lever():
+    (r,) = scenario.load("at_anchor").runs()
+    m = sim.at_anchor("general", 34.246 * DEG, 108.910 * DEG, 0.0, -240.0 * DEG, radius=50.0, period=2400.0,
+                      swing=30.0 * DEG, heave=sim.MOORED_SHIP["heave"], lever_b=sim.MOORED_SHIP["lever_b"])
+    assert_same_ship(r.motion, m)
+    # the firmware is told the lever arm (lever = "configured")
+    cfg = scenario.initial_config(r.motion, None, **r.config)
+    assert np.array_equal(cfg["lever_b_m"], sim.MOORED_SHIP["lever_b"])
+
+
+def test_at_anchor_adds_the_files_waves_to_its_arc_and_refuses_a_wide_swing(tmp_path):
+    text = """
+duration = "60 s"
+[motion]
+kind = "at_anchor"
+sea_state = "bad"
+heading = "90 deg"
+radius = "80 m"
+swing_period = "20 min"
+swing_angle = "%s"
+swing_phase = "45 deg"
+sway = [{ amplitude = "0.3 m", period = "10 s", phase = "0 deg" }]
+"""
+    f = tmp_path / "anchor.toml"
+    f.write_text(text % "60 deg")
+    (r,) = scenario.load(f).runs()
+    surge, sway = sim.anchor_linear(80.0, 1200.0, 60.0 * DEG, 45.0 * DEG)
+    assert r.motion.linear.sway == tuple(sway) + ((0.3, 10.0, 0.0),)
+    assert r.motion.linear.surge == tuple(surge) and r.motion.linear.heave == ()
+    assert np.array_equal(r.motion.lever_b, np.zeros(3))       # no lever unless the file gives one
+    f.write_text(text % "100 deg")
+    with pytest.raises(ScenarioError, match="motion.swing_angle"):
+        scenario.load(f)
+
+
 def test_files_without_ship_keys_build_and_resolve_as_before():
     for name in SEEDS_PAPERS:
         sc = scenario.load(name)
@@ -273,7 +308,7 @@ def test_a_manoeuvre_refuses_the_ship_keys(name):
         scenario.loads(f'duration = "60 s"\n[motion]\nkind = "manoeuvre"\n{name} = {value}\n', source="m.toml")
     assert str(exc.value) == (f"m.toml: motion.{name}: not used with kind 'manoeuvre': heave, surge, sway, "
                               f"spectrum and lever arms need a fixed-position kind (static, swing, sea_state, "
-                              f"heading_swing)")
+                              f"heading_swing, at_anchor)")
 
 
 def test_compare_and_overrides_check_the_ship_keys():
