@@ -472,6 +472,22 @@ bool Firmware::fine_heading_known() const {
     return fine_.heading_variance() <= kValidHeadingSigma * kValidHeadingSigma;
 }
 
+bool Firmware::ref_aided() const {
+    // a reference applied in navigation, or one met during the alignment
+    // (skipped there): from the first navigation tick, no valid record on
+    // the coarse attitude before the first fix arrives
+    for (int i = 0; i < kRefKinds; ++i) {
+        if (ref_seen_[i] != 0 || n_ref_skipped_[i] != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool Firmware::nav_heading_known() const {
+    return nav_.p(nav_filter::kPhi + 2, nav_filter::kPhi + 2) <= kValidNavHeadingSigma * kValidNavHeadingSigma;
+}
+
 void Firmware::end_fine() {
     // Navigation starts from the corrected attitude (both correction modes);
     // a heading the filter does not know to kValidHeadingSigma is not valid
@@ -864,6 +880,13 @@ PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* heigh
         if ((cfg_.integrity_nis_window > 0 && fine_.nis_windows() == 0) || !fine_heading_known()) {
             valid = false;
         }
+    } else if (mode_ == Mode::kNavigate && nav_on_ != 0 && fine_.states() == 0 && cfg_.coarse_ticks > 0 &&
+               ref_aided() && !nav_heading_known()) {
+        // the navigation filter started on the coarse attitude and aided
+        // (an alignment in navigation: indexed, at anchor; after a fine
+        // alignment its end decided, unaided the coarse one's): valid once
+        // three times its heading sigma is within 10' (kValidNavHeadingSigma)
+        valid = false;
     }
     *state_flags = valid && integrity_lost_ == 0 ? static_cast<uint32_t>(PYINS_STATE_ATT_VALID) : 0u;
     if (mode_ == Mode::kNavigate && (refs_in_use() & (1u << (PYINS_REF_GNSS_POS - 1))) != 0u) {

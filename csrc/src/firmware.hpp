@@ -33,6 +33,14 @@ enum class Mode : int32_t {
 /// wide prior the heading wanders far while its sigma is still large
 /// (docs/concepts.md, "Integrity": PSINS's real laser-gyro log).
 inline constexpr double kValidHeadingSigma = 10.0 * kArcminToRad;
+/// The navigation filter started on the coarse attitude (an alignment in
+/// navigation: indexed, at anchor) is valid only once three times its
+/// heading sigma is within those 10': its prior, fitted to the coarse
+/// result, starts just inside 10' (9.8' at anchor), and at one sigma a
+/// ship at anchor was called valid for 132 s while 10.0-10.8' off
+/// (2026-12-06). The fine alignments' rule above is the older, looser one
+/// (docs/concepts.md, "Alignment at anchor").
+inline constexpr double kValidNavHeadingSigma = kValidHeadingSigma / 3.0;
 /// The reference queue's depth (pyins_push_ref) and the kinds' slots.
 inline constexpr int32_t kRefQueue = 8;
 inline constexpr int32_t kRefKinds = 5;
@@ -203,6 +211,11 @@ class Firmware {
     void end_coarse();
     /// The fine filter's heading sigma is within kValidHeadingSigma.
     bool fine_heading_known() const;
+    /// A reference of any kind has been applied in navigation or met
+    /// during the alignment.
+    bool ref_aided() const;
+    /// The navigation filter's heading sigma is within kValidNavHeadingSigma.
+    bool nav_heading_known() const;
     /// Start / leave fine alignment.
     void start_fine();
     void end_fine();

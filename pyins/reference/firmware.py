@@ -29,6 +29,9 @@ U32 = 0xFFFFFFFF
 #: kValidHeadingSigma: a fine-alignment attitude is valid only once the
 #: filter's own heading sigma is within 10'
 VALID_HEADING_SIGMA = 10.0 * ARCMIN_TO_RAD
+#: kValidNavHeadingSigma: the navigation filter started on the coarse
+#: attitude, once three times its heading sigma is within 10'
+VALID_NAV_HEADING_SIGMA = VALID_HEADING_SIGMA / 3.0
 COUNTERS = ("n_nonfinite", "n_saturated", "n_seq_gaps", "n_seq_bridged", "n_seq_repeats",
             "n_seq_lost", "n_encoder_jumps")   #: SampleCounts, as named in pyins_output
 
@@ -356,6 +359,14 @@ class Firmware(NavAtSea):
         """The fine filter's heading sigma is within VALID_HEADING_SIGMA (mirrors fine_heading_known)."""
         return self.fine.p[2, 2] <= VALID_HEADING_SIGMA * VALID_HEADING_SIGMA
 
+    def ref_aided(self):
+        """A reference applied in navigation or met during the alignment (mirrors ref_aided)."""
+        return any(self.ref_seen[i] != 0 or self.n_ref_skipped[i] != 0 for i in range(len(self.ref_seen)))
+
+    def nav_heading_known(self):
+        """The navigation filter's heading sigma is within VALID_NAV_HEADING_SIGMA (mirrors nav_heading_known)."""
+        return self.nav.p[nav_filter.PHI + 2, nav_filter.PHI + 2] <= VALID_NAV_HEADING_SIGMA * VALID_NAV_HEADING_SIGMA
+
     def end_fine(self):
         if not self.fine_heading_known():
             self.att_valid = False
@@ -622,6 +633,9 @@ class Firmware(NavAtSea):
             if ((self.cfg["integrity_nis_window"] > 0 and self.fine.nis_windows == 0)
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
+        elif (self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on and self.kf_states == 0
+              and self.cfg["coarse_ticks"] > 0 and self.ref_aided() and not self.nav_heading_known()):
+            valid = False   # the navigation filter on a coarse attitude: once 3 sigma is within 10'
         state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
         if self.mode == abi.PYINS_MODE_NAVIGATE and self.refs_in_use() & (1 << (abi.PYINS_REF_GNSS_POS - 1)):
             state_flags = state_flags | abi.PYINS_STATE_POS_AIDED

@@ -32,15 +32,26 @@ def test_a_ship_under_way_is_not_aligned():
     assert not np.any(o["state_flags"] & abi.PYINS_STATE_ATT_VALID)
 
 
-def test_a_moored_ship_with_gnss_stays_valid():
+def test_a_moored_ship_with_gnss_is_not_faulted_and_valid_once_known():
     """moored_indexed: 0.5 m heave, 0.3 m surge and sway at 8-12 s (the
     reference point's horizontal speed up to ~0.25 m/s) with GNSS velocity
-    (0.05 m/s) through its FIT coarse alignment: no fault, valid at its end."""
+    (0.05 m/s) through its FIT coarse alignment: no fault. The navigation
+    filter then aligns on the coarse attitude: valid once three times its
+    heading sigma is within 10' (measured from 459 s), and to the end.
+    Until 2026-12-06 it was valid from 121 s, while up to 23' off."""
     res = run(next(iter(scenario.load("moored_indexed").runs())))
     o = res.outputs
     assert not np.any(o["fault_flags"] & abi.PYINS_FAULT_ALIGN_INCONSISTENT)
     t = o["tick"] / 100.0
-    assert np.all(o["state_flags"][t >= 121.0] & abi.PYINS_STATE_ATT_VALID)
+    valid = (o["state_flags"] & abi.PYINS_STATE_ATT_VALID) != 0
+    known = 3.0 * o["nav_sigma_heading_rad"] <= 10.0 * ARCMIN
+    nav = t > 120.0
+    assert np.array_equal(valid[nav], known[nav])
+    first = int(np.argmax(valid))
+    assert valid[first:].all() and 300.0 < t[first] < 600.0
+    # and what the rule keeps out: records far off before it (measured 23')
+    err = np.abs(metrics.nav_errors(res).att_n_rad[:, 2])
+    assert np.max(err[nav & ~valid]) > 10.0 * ARCMIN and np.max(err[valid]) < 10.0 * ARCMIN
 
 
 def _static(n):
