@@ -33,7 +33,7 @@ from pyins import contract, logs, metrics, open_loop, records, scenario, sim
 from pyins.reference import abi
 from pyins.reference.config import DEFAULT_NAV_GATE
 from pyins.reference.fine_align import PHI
-from pyins.reference.firmware import VALID_HEADING_SIGMA
+from pyins.reference.firmware import VALID_HEADING_SIGMA, VALID_NAV_HEADING_SIGMA
 from pyins.report.replay import alignment_figures
 from pyins.truth_track import TruthTrack
 from pyins.rundir import hold_interrupts
@@ -74,6 +74,12 @@ def warnings(recs, aligning, hz):
         elif heading_sigma > VALID_HEADING_SIGMA:
             why = (f"the fine alignment left a heading sigma of {heading_sigma / ARCMIN_TO_RAD:.2f}', above "
                    f"{VALID_HEADING_SIGMA / ARCMIN_TO_RAD:g}': align longer")
+        elif (last["mode"] == abi.PYINS_MODE_NAVIGATE and not last["kf_states"]
+              and last["nav_sigma_heading_rad"] > VALID_NAV_HEADING_SIGMA):
+            nav_sigma = float(last["nav_sigma_heading_rad"]) / ARCMIN_TO_RAD
+            why = (f"the navigation filter aligning on the coarse attitude has a heading sigma of "
+                   f"{nav_sigma:.2f}': three times it is above {VALID_HEADING_SIGMA / ARCMIN_TO_RAD:g}'; "
+                   "aid it longer")
         elif aligning:
             why = "the alignment had not ended"
         else:

@@ -32,6 +32,19 @@ from pyins.logs import nmea as N
 from pyins.reference import earth
 from pyins.sim import references as R
 
+
+#: After 180 s of aided navigation on the coarse attitude (a 300-s slice of
+#: the log) the heading is not yet valid: three times the navigation
+#: filter's heading sigma (4.8' on the zero-velocity replay) is above 10'
+#: (firmware.hpp's kValidNavHeadingSigma, 2026-12-06). The replay says so;
+#: the checks below that nothing else is said keep their meaning.
+NAV_NOT_YET = "the navigation filter aligning on the coarse attitude"
+
+
+def _others(warnings):
+    """The warnings beside the navigation filter's not-yet-valid heading."""
+    return [w for w in warnings if NAV_NOT_YET not in w]
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 LOG = str(ROOT / "tests/data/lasergyro_300s.imu.gz")
 LAT, LON, H = parked_site.LAT, parked_site.LON, parked_site.H
@@ -83,7 +96,7 @@ def test_nmea_fixes_navigate_as_the_same_fixes_in_the_text_layout(tmp_path):
     assert src["option"] == "--gnss" and src["format"] == "NMEA 0183"
     assert src["sigmas"] == {"gnss_pos": {"GST": 181, "assumed": 0}, "gnss_vel": {"--gnss-vel-sigma": 181}}
     assert src["utc_span"] == ["2026-12-05T23:59:00.00", "2026-12-06T00:02:00.00"]
-    assert s["warnings"] == []          # every sigma measured (GST) or stated: nothing assumed
+    assert _others(s["warnings"]) == []          # every sigma measured (GST) or stated: nothing assumed
     assert abs(s["errors"]["horizontal_max_m"] - csv["errors"]["horizontal_max_m"]) < TRACK_TOL
     assert _track_gap(out_csv, out) < TRACK_TOL
 
@@ -166,10 +179,10 @@ def test_files_merge_with_refs_and_zero_velocity_either_way(tmp_path):
     assert a["references"]["sources"][1] == {"option": "--speed-log", "file": str(tmp_path / "log.csv"),
                                              "format": "reference text", "references": {"speed_log": 181}}
     # a speed log has no time in NMEA: said (the only warning of either run)
-    assert b["warnings"] == [f"--speed-log {tmp_path / 'log.nmea'}: 181 VHW carry no time: each took the time "
+    assert _others(b["warnings"]) == [f"--speed-log {tmp_path / 'log.nmea'}: 181 VHW carry no time: each took the time "
                              "of the last timed sentence (GGA, RMC, GST, ZDA) before it, up to 1 s earlier "
                              "(the longest interval between the file's timed epochs)"]
-    assert a["warnings"] == []
+    assert _others(a["warnings"]) == []
     assert _track_gap(out_a, out_b) < TRACK_TOL
 
 

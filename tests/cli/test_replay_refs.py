@@ -21,6 +21,20 @@ from pyins import __main__ as cli
 from pyins import contract
 from pyins.sim import references as R
 
+
+#: After 180 s of aided navigation on the coarse attitude (a 300-s slice of
+#: the log) the heading is not yet valid: three times the navigation
+#: filter's heading sigma (4.8' on the zero-velocity replay) is above 10'
+#: (firmware.hpp's kValidNavHeadingSigma, 2026-12-06). The replay says so;
+#: the checks below that nothing else is said keep their meaning.
+NAV_NOT_YET = "the navigation filter aligning on the coarse attitude"
+
+
+def _others(warnings):
+    """The warnings beside the navigation filter's not-yet-valid heading."""
+    return [w for w in warnings if NAV_NOT_YET not in w]
+
+
 LOG = "tests/data/lasergyro_300s.imu.gz"
 LAT, LON, H = parked_site.LAT, parked_site.LON, parked_site.H
 SITE = ["--lat", str(LAT), "--lon", str(LON), "--height", str(H), "--coarse", "120"]
@@ -54,7 +68,8 @@ def test_zero_velocity_holds_a_parked_vehicle_on_real_data(tmp_path, unaided):
     # one a second from the end of the alignment (120 s) to the log's end (300 s)
     assert k["given"] == 181 and k["used"] == 181 and k["rejected"] == 0 and k["skipped"] == 0
     assert s["references"]["zero_velocity_mps"] == 0.01
-    assert s["warnings"] == [] and s["final"]["fault_flags"] == 0
+    assert _others(s["warnings"]) == [] and s["final"]["fault_flags"] == 0
+    assert any(NAV_NOT_YET in w and "aid it longer" in w for w in s["warnings"])
     assert (out / "references.png").exists()
     page = (out / "report.html").read_text()
     assert "references.png" in page and "references zero_velocity" in page
@@ -83,7 +98,7 @@ def test_a_reference_file_aids_the_navigation(tmp_path, unaided):
     assert kinds["gnss_pos"]["used"] + kinds["gnss_pos"]["rejected"] == 181
     assert s["references"]["file_span_s"] == [120.0, 300.0]
     # (a rejection or two is the gate's 0.1 % false alarms: counted, not warned about)
-    assert s["warnings"] == []
+    assert _others(s["warnings"]) == []
 
 
 def test_a_file_that_does_not_cover_the_log_is_warned_about_and_kept(tmp_path, capsys):
