@@ -881,7 +881,7 @@ PYINS_HOT_INLINE void Firmware::solution(double* lat, double* lon, double* heigh
             valid = false;
         }
     } else if (mode_ == Mode::kNavigate && nav_on_ != 0 && fine_.states() == 0 && cfg_.coarse_ticks > 0 &&
-               ref_aided() && !nav_heading_known()) {
+               !nav_heading_known() && ref_aided()) {
         // the navigation filter started on the coarse attitude and aided
         // (an alignment in navigation: indexed, at anchor; after a fine
         // alignment its end decided, unaided the coarse one's): valid once

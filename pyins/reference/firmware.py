@@ -634,7 +634,7 @@ class Firmware(NavAtSea):
                     or not self.fine_heading_known()):
                 valid = False   # provisional until the first NIS window, and the heading known
         elif (self.mode == abi.PYINS_MODE_NAVIGATE and self.nav_on and self.kf_states == 0
-              and self.cfg["coarse_ticks"] > 0 and self.ref_aided() and not self.nav_heading_known()):
+              and self.cfg["coarse_ticks"] > 0 and not self.nav_heading_known() and self.ref_aided()):
             valid = False   # the navigation filter on a coarse attitude: once 3 sigma is within 10'
         state_flags = abi.PYINS_STATE_ATT_VALID if valid and not self.integrity_lost else 0
         if self.mode == abi.PYINS_MODE_NAVIGATE and self.refs_in_use() & (1 << (abi.PYINS_REF_GNSS_POS - 1)):

@@ -639,6 +639,19 @@ def _bessel_j(n, x):
     return total
 
 
+def _checked_swing(period, swing, phase):
+    """The swing's period [s], half angle [rad] and phase [rad] as floats,
+    or a ValueError naming the one out of range."""
+    period, swing, phase = float(period), float(swing), float(phase)
+    if not (np.isfinite(period) and period > 0.0):
+        raise ValueError(f"period: {period!r} s, must be finite and > 0")
+    if not (np.isfinite(swing) and 0.0 <= swing <= np.pi / 2.0):
+        raise ValueError(f"swing: {swing!r} rad, the half angle must be within 0..90 deg")
+    if not np.isfinite(phase):
+        raise ValueError(f"phase: {phase!r} rad, must be finite")
+    return period, swing, phase
+
+
 def anchor_linear(radius, period, swing, phase=0.0):
     """Sway and surge of a ship's reference point on its arc about the anchor.
 
@@ -663,15 +676,10 @@ def anchor_linear(radius, period, swing, phase=0.0):
     arc's mean. Returns ``(surge, sway)`` as `LinearMotion` components
     ((amplitude [m], period [s], phase [rad]), ...).
     """
-    radius, period, swing, phase = float(radius), float(period), float(swing), float(phase)
+    radius = float(radius)
     if not (np.isfinite(radius) and 0.0 <= radius <= 1000.0):
         raise ValueError(f"radius: {radius!r} m, must be within 0..1000 m")
-    if not (np.isfinite(period) and period > 0.0):
-        raise ValueError(f"period: {period!r} s, must be finite and > 0")
-    if not (np.isfinite(swing) and 0.0 <= swing <= np.pi / 2.0):
-        raise ValueError(f"swing: {swing!r} rad, the half angle must be within 0..90 deg")
-    if not np.isfinite(phase):
-        raise ValueError(f"phase: {phase!r} rad, must be finite")
+    period, swing, phase = _checked_swing(period, swing, phase)
     sway, surge = [], []
     for k in range(1, _ARC_HARMONICS + 1):
         a = 2.0 * radius * _bessel_j(k, swing)
@@ -686,12 +694,10 @@ def anchor_swing(sea_state_name, lat, lon, height, yaw0, period, swing, phase=0.
     """The attitude of a ship at anchor (`at_anchor`): the sea state's pitch
     and roll, yaw0 - theta(t) with theta(t) = swing sin(2 pi t / period +
     phase)."""
-    anchor_linear(0.0, period, swing, phase)        # the same checks of period, swing, phase
+    period, swing, phase = _checked_swing(period, swing, phase)
     sea = sea_state(sea_state_name, lat, lon, height, yaw0, pitch0, roll0)
-    return Swing(lat, lon, height, pitch0, roll0, yaw0,
-                 [sea.amplitude[0], sea.amplitude[1], float(swing)],
-                 [sea.frequency_hz[0], sea.frequency_hz[1], 1.0 / float(period)],
-                 [0.0, 0.0, float(phase) + np.pi])
+    return Swing(lat, lon, height, pitch0, roll0, yaw0, [sea.amplitude[0], sea.amplitude[1], swing],
+                 [sea.frequency_hz[0], sea.frequency_hz[1], 1.0 / period], [0.0, 0.0, phase + np.pi])
 
 
 def at_anchor(sea_state_name, lat, lon, height, yaw0, radius=AT_ANCHOR["radius"],
