@@ -45,7 +45,7 @@ from pyins import scenario as scenario_mod
 from pyins.campaign.aggregate import aggregate, plan, read_summary, write_json
 
 __all__ = ["CampaignError", "CampaignInterrupted", "run_campaign", "pending", "DASK_CONNECT_TIMEOUT",
-           "STOP_GRACE_S"]
+           "STOP_GRACE_S", "check_scheduler_address"]
 
 DASK_CONNECT_TIMEOUT = "20s"   #: how long to wait for a Dask scheduler
 #: After Ctrl-C: how long the runs in flight get to write their partial
@@ -60,6 +60,31 @@ class CampaignError(RuntimeError):
     def __init__(self, message, result=None):
         super().__init__(message)
         self.result = result
+
+
+#: The address schemes dask.distributed connects by (``inproc`` is one process's own)
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+
+
+def check_scheduler_address(address):
+    """Refuse a Dask scheduler address that cannot name one (CampaignError
+    naming what is wrong), before anything is written or dask imported: "0"
+    or "host" with no port would otherwise fail only after dask's import, or
+    wait out DASK_CONNECT_TIMEOUT. Accepts ``[scheme://]host:port`` with a
+    scheme of DASK_SCHEMES and a port 1..65535 (``inproc://`` as it is)."""
+    text = str(address).strip()
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme not in DASK_SCHEMES:
+        raise CampaignError(f"--scheduler {address}: the scheme {scheme}:// is not one dask connects by "
+                            f"({', '.join(s + '://' for s in DASK_SCHEMES)})")
+    if scheme == "inproc":
+        return
+    host, colon, port = rest.rstrip("/").rpartition(":")
+    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise CampaignError(f"--scheduler {address}: not a scheduler address; give host:port with a port "
+                            f"of 1 to 65535, e.g. tcp://127.0.0.1:8786")
 
 
 class CampaignInterrupted(KeyboardInterrupt):
@@ -251,7 +276,7 @@ def _run_dask(tasks, scheduler, on_done, on_stopped):
     if own:
         try:
             client = distributed.Client(scheduler, timeout=DASK_CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise CampaignError(f"cannot connect to the Dask scheduler {scheduler}: "
                                 f"{_first_line(exc)}") from None
     else:
@@ -305,6 +330,8 @@ def run_campaign(camp, out_dir, workers=None, scheduler=None, progress=None, log
     """
     t0 = time.perf_counter()
     out_dir = str(out_dir)
+    if scheduler is not None and isinstance(scheduler, str):
+        check_scheduler_address(scheduler)
     notes = []                  # every notice told is kept in campaign.json (execution.notes)
 
     def noting(text):

@@ -171,6 +171,23 @@ def test_dask_needs_a_reachable_scheduler(tmp_path, monkeypatch):
         campaign.run_campaign(camp, tmp_path, scheduler="tcp://127.0.0.1:9", plots=False)
 
 
+@pytest.mark.parametrize("address", ["0", "host", "tcp://h:0", "h:99999", "http://h:8786", "tcp://:8786"])
+def test_a_scheduler_address_that_names_none_is_refused_before_anything_is_written(address, tmp_path):
+    # refused by its form, before dask is imported: "0" once went to dask's import (seconds on a
+    # fresh clone) and a host with no port to the connection timeout
+    camp = campaign.from_args("seed000_static", ["motion.heading=0 deg"], 1)
+    out = tmp_path / "out"
+    with pytest.raises(campaign.CampaignError, match=f"--scheduler {address}: "):
+        campaign.run_campaign(camp, out, scheduler=address, plots=False)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:8786", "127.0.0.1:8786", "tls://host.example:8786",
+                                     "inproc://10.0.0.1/123/1", "tcp://[::1]:8786"])
+def test_a_scheduler_address_of_every_form_dask_takes_passes_the_check(address):
+    campaign_execute.check_scheduler_address(address)
+
+
 # ---------------------------------------------------------------------------
 # Kill and resume
 # ---------------------------------------------------------------------------
