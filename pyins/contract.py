@@ -150,8 +150,9 @@ _STATUS_MEANING = {
                           "(0 = default)",
     "PYINS_E_CONFIG_INDEX_SUMS": "index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL",
     "PYINS_E_CONFIG_LEVER": "lever_b_m, lever_p_m, dvl_lever_b_m and gnss_lever_b_m must be finite and at most 100 m long",
-    "PYINS_E_CONFIG_COARSE_METHOD": "coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or "
-                                    "PYINS_COARSE_EQ8",
+    "PYINS_E_CONFIG_COARSE_METHOD": "coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT, "
+                                    "PYINS_COARSE_EQ8 or PYINS_COARSE_FIT_VEL; PYINS_COARSE_FIT_VEL needs "
+                                    "fine_ticks 0 and nav_mode not PYINS_NAV_UNDAMPED",
     "PYINS_E_CONFIG_INTEGRITY": "integrity_nis_window must be -1 (off), 0 (default) or positive, "
                                 "integrity_nis_max and integrity_coarse_rad finite and not negative",
     "PYINS_E_CONFIG_NAV": "nav_mode must be AUTO, UNDAMPED, DAMPED or INTEGRATED, nav_every_ticks 1..10 s, "

@@ -28,7 +28,7 @@ from . import contract
 from ._cdef import read_cdef
 
 #: The ABI this Python code was written against: (major, minor).
-EXPECTED_ABI = (0, 19)
+EXPECTED_ABI = (0, 20)
 
 _LIB_NAME = "libpyins_core.so"
 _HEADERS = ("pyins_core.h", "pyins_core_testing.h", "pyins_plant.h")

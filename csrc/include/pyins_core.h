@@ -28,7 +28,7 @@
 
 /* ABI version: (major << 16) | minor. A major change breaks callers. */
 #define PYINS_ABI_VERSION_MAJOR 0
-#define PYINS_ABI_VERSION_MINOR 19
+#define PYINS_ABI_VERSION_MINOR 20
 
 #ifdef __cplusplus
 extern "C" {
@@ -151,8 +151,13 @@ enum pyins_coarse_method {
                                      smooth functions that ignore an unknown initial velocity and
                                      position offset and suppress bounded wave motion
                                      (docs/concepts.md, "Alignment on a moving base") */
-    PYINS_COARSE_EQ8 = 2          /* seed 000 eq. 8 as printed: the same vectors as TRIAD, C_ib0^i =
+    PYINS_COARSE_EQ8 = 2,         /* seed 000 eq. 8 as printed: the same vectors as TRIAD, C_ib0^i =
                                      A^-1 B, not orthonormalised (docs/core.md) */
+    PYINS_COARSE_FIT_VEL = 3      /* under way: FIT with the ship's motion taken out by the GNSS velocity
+                                     references pushed during the alignment (ABI 0.20); navigation
+                                     starts where they carried the ship, at their velocity. Needs
+                                     fine_ticks 0 and a navigation filter (nav_mode not UNDAMPED), which
+                                     then aligns finely (docs/concepts.md, "Alignment under way") */
 };
 
 /* How the fine alignment uses its attitude estimate. */
@@ -186,7 +191,9 @@ enum pyins_fault_flag {
                                              (align_nis) beyond integrity_nis_max, or a reference
                                              velocity during an alignment says the site moves (more
                                              than 0.5 m/s beyond its noise and lever arm: a ship under
-                                             way, ABI 0.18); the attitude is not valid */
+                                             way, ABI 0.18), or an alignment under way
+                                             (PYINS_COARSE_FIT_VEL) that went more than 3 s without a
+                                             GNSS velocity (ABI 0.20); the attitude is not valid */
     PYINS_FAULT_COARSE_UNSETTLED = 512, /* the coarse solution kept moving over the last fifth of the
                                           coarse alignment by more than integrity_coarse_rad
                                           (coarse_wander_rad); the attitude is not valid */

@@ -43,12 +43,13 @@ int checked(const pyins_core* core, const Firmware** fw) {
 }
 
 constexpr uint32_t kSnapMagic = 0x4E535950u;  // "PYSN" little-endian
-constexpr uint32_t kSnapFormat = 8u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT;
+constexpr uint32_t kSnapFormat = 9u;  // 2: sample-level fault state (seq, counters); 3: lever arm, coarse FIT;
                                       // 4: the navigation filter and the reference queue; 5: the DVL's
                                       // mounting in the configuration (ABI 0.16); 6: the damping
                                       // references of nav_mode DAMPED (ABI 0.17); 7: the navigation
                                       // filter's bias random walk and table-move model (ABI 0.18); 8: the
-                                      // gyros' scale factors and misalignments as filter states (ABI 0.19)
+                                      // gyros' scale factors and misalignments as filter states (ABI 0.19);
+                                      // 9: the coarse alignment under way (ABI 0.20)
 constexpr size_t kSnapHeader = 24u;
 
 /// CRC-32 (IEEE 802.3, reflected, bitwise: small, no table).
@@ -449,7 +450,7 @@ const char* pyins_status_str(int status) {
         case PYINS_E_CONFIG_SEQ: return "PYINS_E_CONFIG_SEQ: seq_mode must be PYINS_SEQ_OFF or PYINS_SEQ_CHECK, seq_max_gap_ticks 1..100 (0 = default)";
         case PYINS_E_CONFIG_INDEX_SUMS: return "PYINS_E_CONFIG_INDEX_SUMS: index_sums must be PYINS_INDEX_SUMS_STOPS or PYINS_INDEX_SUMS_ALL";
         case PYINS_E_CONFIG_LEVER: return "PYINS_E_CONFIG_LEVER: lever_b_m, lever_p_m, dvl_lever_b_m and gnss_lever_b_m must be finite and at most 100 m long";
-        case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT or PYINS_COARSE_EQ8";
+        case PYINS_E_CONFIG_COARSE_METHOD: return "PYINS_E_CONFIG_COARSE_METHOD: coarse_method must be PYINS_COARSE_TRIAD, PYINS_COARSE_FIT, PYINS_COARSE_EQ8 or PYINS_COARSE_FIT_VEL; PYINS_COARSE_FIT_VEL needs fine_ticks 0 and nav_mode not PYINS_NAV_UNDAMPED";
         case PYINS_E_CONFIG_INTEGRITY: return "PYINS_E_CONFIG_INTEGRITY: integrity_nis_window must be -1 (off), 0 (default) or positive, integrity_nis_max and integrity_coarse_rad finite and not negative";
         case PYINS_E_CONFIG_NAV: return "PYINS_E_CONFIG_NAV: nav_mode must be AUTO, UNDAMPED, DAMPED or INTEGRATED, nav_every_ticks 1..10 s, nav_gate positive and finite, nav_reject_limit >= 1, ref_max_latency_ticks 1..10 s (0 = default); nav_gyro_bias_rw 0..1e-6 rad/s/sqrt(s), nav_table_scale_sigma, nav_table_mis_sigma, nav_level_scale_sigma and nav_level_mis_sigma 0..0.01 (0 = not modelled)";
         case PYINS_E_REF_KIND: return "PYINS_E_REF_KIND: unknown reference kind, or one this build does not use (GNSS_POS, GNSS_VEL, SPEED_LOG, DVL bottom track, ZERO_VEL are used; a DVL with reserved != 0, water track, is not)";

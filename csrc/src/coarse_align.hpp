@@ -77,6 +77,53 @@
 // the firmware reports none with PYINS_STATE_ATT_VALID before the alignment
 // has ended and passed this test.
 //
+// Under way (method FIT_VEL). A ship under way moves by hundreds of metres
+// in an alignment: FIT's unknown initial velocity is no longer the whole of
+// it. With a reference velocity v^n of the reference point (a GNSS receiver's,
+// time-tagged) the motion is taken out of the inertial side instead. For the
+// reference point (f^n = v' + (2 w_ie + w_en) x v - g^n, Titterton & Weston
+// eq. 3.74) and d/dt (C_n^i v) = C_n^i (v' + w_in x v):
+//   C_n^i f^n = d/dt (C_n^i v) + C_n^i (w_ie^n x v) + g up^i,
+// so the reference point's v^i = int f^i is
+//   v^i(t) = C_n^i(t) v(t) + K(t) - C_n^i(0) v(0),  K = int (g up^i + C_n^i (w_ie^n x v)),
+// and C_ib0^i v^ib0(t) = v^i(t) with an unknown constant. Here n is the frame
+// at the SHIP (its latitude and longitude carried from t0 by the reference
+// velocity, R_M + h and R_N + h of the site): the transport rate turns it
+// v / R against the Earth's Omega cos L, which a fixed n would read as a
+// heading bias of v / (R Omega cos L), 54' at 12 kn and 34 deg. K is
+// integrated each tick by the trapezoid rule (its integrand at the tick
+// ends, the velocity in it the last reference's).
+// The solution is FIT's at the velocity level: v^ib0 and v^i on the grid
+// projected on two weights of s = t / T orthogonal to 1 (the unknown
+// constant drops out exactly on the grid), the Legendre polynomials
+//   psi_a(s) = s - 1/2 (the gravity term, g up^i t),
+//   psi_b(s) = s^2 - s + 1/6 (the Earth's rotation of it, g cos L Omega t^2 / 2),
+// made exactly orthogonal to 1 (psi_a) and to 1 and s (psi_b) on the grid,
+// and the two pairs through the TRIAD anchored on the gravity pair. The
+// reference's white velocity noise (sigma per sample) is what limits it, and
+// least squares on {1, t, t^2} is the best a linear fit does with it: the
+// heading's sigma is sigma / sqrt(sum q_k^2) / (g cos L Omega / 2), q the
+// grid's quadratic orthogonal to 1 and t in seconds (heading_sigma()): 50'
+// for 0.05 m/s at 1 Hz over 120 s at 34 deg. FIT's end-tapered weights
+// (the waves) are not needed: the reference's velocity carries the waves,
+// and at the position level they would pick the velocity noise up as a
+// random walk (165' in the same case).
+// A grid point's i side (the grid's upper half) is K at its tick at once,
+// and C_n^i v when the first reference at or after its tick comes (v linear
+// between references; ref_done counts the complete points; the solution
+// uses those, so it lags a reference interval, which C_ib0^i, a constant,
+// does not mind). Before the first reference the velocity is taken as that
+// reference's.
+// The reference's antenna sits at l^b from the reference point: it moves at
+// v + d/dt (C_b^n l^b), and C_n^i d/dt(C_b^n l) = d/dt (C_b^i l) less
+// w_in x terms of 1e-4 m/s; C_b^i l^b = C_ib0^i C_p^ib0 C_b^p l^b, so that
+// term moves to the ib0 side: the grid holds v^ib0 + C_p^ib0 (C_b^p l^b)
+// (ref_lever_p, passed to update()). The reference's vertical velocity
+// (heave) is not taken: its part, C up^i v_U, is a wave's bounded velocity,
+// which the weights (smooth over the alignment) do not pick up. Integrity:
+// the longest interval without a reference (ref_gap, from t0) is kept; the
+// firmware faults an alignment whose gap exceeded ref_gap_max ticks.
+//
 // Noise (for the fine alignment's R; docs/core.md, "Measurement noise of
 // the fine alignment"). The static fine filters measure the specific force
 // averaged over tau = noise_every ticks; their R must be the variance of
@@ -107,7 +154,18 @@ namespace pyins::coarse_align {
 inline constexpr int kHistLen = 256;
 
 /// How C_ib0^i is solved (enum pyins_coarse_method).
-enum class Method : int32_t { kTriad = 0, kFit = 1, kEq8 = 2 };
+enum class Method : int32_t { kTriad = 0, kFit = 1, kEq8 = 2, kFitVel = 3 };
+
+/// FIT_VEL holds its grid of v^ib0 in grid[0 .. kFitVelLen - 1] and the i
+/// side on the same points (K, then + C_n^i v once a reference covers it)
+/// in grid[kFitVelLen ..]: no storage beyond FIT's (it halves its grid at
+/// kFitVelLen points, 128 s at 1 s outputs).
+inline constexpr int32_t kFitVelLen = kHistLen / 2;
+
+/// FIT_VEL's wander test: the noise moves the solution by about its sigma
+/// over the last fifth (the first solution's sigma is (5/4)^2.5 = 1.75 times
+/// the last's); four of its sigmas before integrity calls it unsettled.
+inline constexpr double kWanderSigmas = 4.0;
 
 /// FIT needs this many grid intervals at its first output (a polynomial
 /// weight of degree 7 sampled on fewer points is not orthogonal to 1 and s).
@@ -126,10 +184,13 @@ struct Params {
     double gravity;          ///< normal gravity at the site [m/s^2]
     int64_t settle_from;     ///< first tick of the wander test
     int32_t noise_every;     ///< ticks per block of the noise measurement (tau); 0: none
-    int32_t unused = 0;      ///< fills the tail: no padding, so a Params copied from a stack
-                             ///< local (CoarseAlign::prm) carries no undefined bytes into a snapshot
+    int32_t ref_gap_max = 0; ///< FIT_VEL: the longest interval without a reference it trusts [ticks]
+                             ///< (also fills the tail: no padding, so a Params copied from a stack
+                             ///< local (CoarseAlign::prm) carries no undefined bytes into a snapshot)
+    double rm_h = 0.0;       ///< FIT_VEL: R_M + h at the site [m]
+    double rn_h = 0.0;       ///< FIT_VEL: R_N + h at the site [m]
 };
-static_assert(sizeof(Params) == 6 * sizeof(int32_t) + 5 * sizeof(double) + sizeof(int64_t),
+static_assert(sizeof(Params) == 6 * sizeof(int32_t) + 7 * sizeof(double) + sizeof(int64_t),
               "coarse_align::Params has no padding");
 
 /// Second differences needed before measured_vrw reports a value (5 s at
@@ -157,6 +218,20 @@ struct CoarseAlign {
     int32_t noise_seen;      ///< block ends seen (capped at 3)
     double noise_sum;        ///< sum of |d_h|^2 [(m/s^2)^2]
     int64_t noise_n;         ///< second differences in it
+    // Under way (FIT_VEL; see the header)
+    int32_t ref_done;        ///< grid points whose i side is complete
+    int32_t ref_count;       ///< references taken (capped at 2^30)
+    double dlat;             ///< the reference point's latitude since t0 [rad]
+    double dlon;             ///< its longitude since t0 [rad]
+    double ref_vel[2];       ///< the last reference velocity (E, N) [m/s]
+    int64_t ref_tick;        ///< its tick, counted as tick is (-1: none yet)
+    int64_t ref_gap;         ///< the longest interval without a reference so far [ticks]
+    Vec3 known_f;            ///< g up^i + C_n^i (w_ie^n x v) at the last tick [m/s^2]
+    Vec3 known_v;            ///< its integral, K [m/s]
+    Vec3 ref_cv;             ///< C_n^i v at t_ref [m/s]
+    double ref_var;          ///< sum of the references' horizontal variances, max(E, N) [m^2/s^2]
+    double sigma_heading;    ///< the latest solution's heading sigma (heading_sigma) [rad]
+    double settle_sigma;     ///< FIT_VEL: sigma_heading of the wander test's first solution [rad]
 };
 
 /// Sine of the rotation angle between two rotation matrices (1 beyond 90 deg).
@@ -199,10 +274,40 @@ double measured_vrw(const CoarseAlign& a);
 void init(CoarseAlign& a, const Params& prm);
 
 /// Take one sample; solves C_ib0^i at the output ticks. lever_vel_p: u^p at
-/// the end of the tick [m/s] (read only with prm.lever).
-void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p);
+/// the end of the tick [m/s] (read only with prm.lever); ref_lever_p: the
+/// reference's antenna from the reference point in p, C_b^p l^b [m] (read
+/// only by FIT_VEL).
+void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p,
+            const Vec3& ref_lever_p);
 
-/// C_p^n now (eq. 1); for EQ8, whose product is not a rotation, the rotation
+/// FIT_VEL: C_n^e at the reference point (rows E, N, U in the e frame whose
+/// x axis lies on the site meridian; dlon from it): mat_n_e turned by dlon.
+Mat3 mat_n_e_at(double sin_lat, double cos_lat, double sin_dlon, double cos_dlon);
+
+/// FIT_VEL: g up^i + C_n^i (w_ie^n x v) at time t for the reference point at
+/// (lat, dlon) moving at v (E, N) [m/s^2] (see the header).
+Vec3 known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
+                   double gravity, double ve, double vn);
+
+/// FIT_VEL: C_n^i v at time t [m/s].
+Vec3 ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon, double ve,
+               double vn);
+
+/// FIT_VEL: take a reference velocity (E, N) [m/s] of the reference point
+/// with its sigma (the larger of E, N) [m/s], valid at alignment tick
+/// ref_tick (a.tick or earlier; one not newer than the last is ignored):
+/// completes the grid points it covers.
+void reference(CoarseAlign& a, double ve, double vn, double sigma, int64_t ref_tick);
+
+/// FIT_VEL: C_ib0^i from v^ib0 (grid) and the i side (grid_i) on the grid
+/// points 0 .. n - 1 by the Legendre weights (see the header).
+Mat3 solve_vel_grid(const Vec3* grid, const Vec3* grid_i, int32_t n);
+
+/// FIT_VEL: the heading sigma of a solution on n grid points t_step [s]
+/// apart from references of mean variance var [m^2/s^2] (see the header) [rad].
+double heading_sigma(int32_t n, double t_step, double var, double gravity, double cos_lat);
+
+/// C_p^n now (eq. 1; FIT_VEL: with n at the reference point now); for EQ8, whose product is not a rotation, the rotation
 /// of the Euler angles read off it (see the header). Precondition: a.solved.
 Mat3 mat_n_p(const CoarseAlign& a);
 

@@ -220,7 +220,8 @@ int config_check(const pyins_config& raw) {
             static_cast<double>(every)) {
             return PYINS_E_CONFIG_ALIGN_EARLY;
         }
-        if (cfg.coarse_method != PYINS_COARSE_FIT && cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
+        if (cfg.coarse_method != PYINS_COARSE_FIT && cfg.coarse_method != PYINS_COARSE_FIT_VEL &&
+            cfg.coarse_ticks / every > coarse_align::kHistLen - 1) {
             return PYINS_E_CONFIG_ALIGN_LONG;
         }
     }
@@ -268,10 +269,16 @@ int config_check(const pyins_config& raw) {
         }
     }
     if (cfg.coarse_method != PYINS_COARSE_TRIAD && cfg.coarse_method != PYINS_COARSE_FIT &&
-        cfg.coarse_method != PYINS_COARSE_EQ8) {
+        cfg.coarse_method != PYINS_COARSE_EQ8 && cfg.coarse_method != PYINS_COARSE_FIT_VEL) {
         return PYINS_E_CONFIG_COARSE_METHOD;
     }
-    if (cfg.coarse_method == PYINS_COARSE_FIT && cfg.coarse_ticks > 0 &&
+    // under way the static fine filters cannot follow: the navigation filter aligns finely
+    if (cfg.coarse_method == PYINS_COARSE_FIT_VEL && cfg.coarse_ticks > 0 &&
+        (cfg.fine_ticks > 0 || cfg.nav_mode == PYINS_NAV_UNDAMPED)) {
+        return PYINS_E_CONFIG_COARSE_METHOD;
+    }
+    if ((cfg.coarse_method == PYINS_COARSE_FIT || cfg.coarse_method == PYINS_COARSE_FIT_VEL) &&
+        cfg.coarse_ticks > 0 &&
         cfg.coarse_first_output_ticks / cfg.coarse_output_every_ticks < coarse_align::kFitMinIntervals) {
         return PYINS_E_CONFIG_ALIGN_EARLY;
     }

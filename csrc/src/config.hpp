@@ -105,6 +105,12 @@ inline constexpr double kMaxNavTableSigma = 0.01;
 /// transport rate, a heading bias of v / (R Omega cos L): 4.5' at 34 deg,
 /// 10' at 70 deg. Faster, the alignment cannot be right.
 inline constexpr double kAlignMaxSpeed = 0.5;
+/// The longest an alignment under way (PYINS_COARSE_FIT_VEL) goes without a
+/// GNSS velocity [s]: its integral of the velocity is linear in between, off
+/// by a' h^2 / 8 in a turn of acceleration a' (0.04 m at 0.16 m/s^2 and 1 s,
+/// 0.4 m at 3 s: 0.3' and 3' of heading against the 132 m of the Earth's
+/// rate over 120 s), and a gap of seconds is a receiver that is not tracking.
+inline constexpr int32_t kCoarseRefGapS = 3;
 /// Initial sigmas of the navigation filter's position and velocity when
 /// navigation starts from an alignment at the site [m, m/s] (the site's
 /// survey; the alignment's velocity residual), and of its attitude when no

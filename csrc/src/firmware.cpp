@@ -146,6 +146,10 @@ void Firmware::init(const pyins_config& raw) {
         pmath::sincos(cfg.lat_rad, &prm.sin_lat, &prm.cos_lat);
         prm.gravity = earth::normal_gravity(prm.sin_lat, cfg.height_m);
         prm.settle_from = cfg.coarse_ticks - cfg.coarse_ticks / 5;
+        prm.ref_gap_max = config::kCoarseRefGapS * cfg.tick_hz;
+        const earth::PrincipalRadii radii = earth::principal_radii(prm.sin_lat);
+        prm.rm_h = radii.rm + cfg.height_m;
+        prm.rn_h = radii.rn + cfg.height_m;
         // the noise the static fine filters' R is built from, measured on
         // their update interval (coarse_align.hpp, "Noise")
         const bool static_fine = cfg.fine_ticks > 0 && fine_filter::static_base(cfg.fine_states);
@@ -263,6 +267,15 @@ Vec3 Firmware::lever_b_in_p() const {
     double ca;
     encoder_sincos(&sa, &ca);
     const double* lb = cfg_.lever_b_m;
+    return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
+}
+
+Vec3 Firmware::gnss_lever_p() const {
+    // Rz(alpha)^T gnss_lever_b, as lever_b_in_p
+    double sa;
+    double ca;
+    encoder_sincos(&sa, &ca);
+    const double* lb = cfg_.gnss_lever_b_m;
     return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
 }
 
@@ -392,14 +405,34 @@ void Firmware::index_reset() {
 void Firmware::end_coarse() {
     // The next phase starts where the coarse alignment ends: the site
     // position, at rest, with the coarse attitude and the increment history
-    // (so the coning terms continue without a gap).
+    // (so the coning terms continue without a gap). Under way: where the
+    // references carried the reference point, at the last one's velocity
+    // less its antenna's lever (coarse_align.hpp, "Under way").
     strapdown::NavState nav = sd_.nav;
     nav.vel_n = Vec3::Zero();
     nav.quat_np = attitude::mat_to_quat(coarse_align::mat_n_p(coarse_));
+    double lat = cfg_.lat_rad;
+    double lon = sd_.ref_lon;
+    if (coarse_.prm.method == static_cast<int32_t>(coarse_align::Method::kFitVel)) {
+        const int64_t since = coarse_.ref_tick < 0 ? coarse_.tick : coarse_.tick - coarse_.ref_tick;
+        if (coarse_.ref_tick < 0 || coarse_.ref_gap > coarse_.prm.ref_gap_max ||
+            since > coarse_.prm.ref_gap_max) {
+            faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_ALIGN_INCONSISTENT);
+            integrity_lost_ = 1;
+        }
+        lat = lat + coarse_.dlat;
+        lon = wrap_pi(lon + coarse_.dlon);
+        nav.lat = lat;
+        nav.lon = lon;
+        sd_.nav = nav;   // point_vel_n reads the latitude
+        const Vec3 lever_v = point_vel_n(attitude::quat_mul_z(nav.quat_np, enc_cos_half_, -enc_sin_half_),
+                                         cfg_.gnss_lever_b_m);
+        nav.vel_n = Vec3(coarse_.ref_vel[0] - lever_v(0), coarse_.ref_vel[1] - lever_v(1), 0.0);
+    }
     sd_ = strapdown::make_strapdown(nav, sd_.vertical);
     sd_.hist = coarse_.hist;
     if (has_lever_ != 0) {
-        place_imu(cfg_.lat_rad, sd_.ref_lon, cfg_.height_m, Vec3::Zero());
+        place_imu(lat, lon, cfg_.height_m, nav.vel_n);
     }
     att_valid_ = true;
     if (cfg_.fine_ticks > 0) {
@@ -791,8 +824,16 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
     //    alignment, or navigation with the indexing cycle.
     if (mode_ == Mode::kCoarseAlign) {
         coarse_align::update(coarse_, dtheta_p, dv_p,
-                             has_lever_ != 0 ? lever_vel_p() : Vec3::Zero());
-        if (coarse_.wander > coarse_wander_max_) {
+                             has_lever_ != 0 ? lever_vel_p() : Vec3::Zero(), gnss_lever_p());
+        // under way the noise's own wander is allowed (coarse_align.hpp, "Under way")
+        double wander_max = coarse_wander_max_;
+        const double noise_wander = coarse_align::kWanderSigmas * coarse_.settle_sigma;
+        if (noise_wander >= 0.5 * kPi) {
+            wander_max = 1.0;
+        } else if (pmath::sin(noise_wander) > wander_max) {
+            wander_max = pmath::sin(noise_wander);
+        }
+        if (coarse_.wander > wander_max) {
             faults_ = faults_ | static_cast<uint32_t>(PYINS_FAULT_COARSE_UNSETTLED);
             integrity_lost_ = 1;
         }

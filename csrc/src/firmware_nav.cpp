@@ -61,6 +61,17 @@ void Firmware::start_nav_filter() {
         fitted[0] = fp.sigma0_att[0];
         fitted[1] = fp.sigma0_att[1];
         fitted[2] = fp.sigma0_att[2];
+        if (coarse_.prm.method == static_cast<int32_t>(coarse_align::Method::kFitVel) &&
+            cfg_.fine_sigma0_att_rad[2] == 0.0) {
+            // under way the reference velocity's noise adds its heading sigma
+            // (coarse_align.hpp, "Under way"), with the same margin
+            const double h = fine_align::kAfterCoarseMargin * coarse_.sigma_heading;
+            double v = pmath::sqrt(fitted[2] * fitted[2] + h * h);
+            if (v > defaults[2]) {
+                v = defaults[2];
+            }
+            fitted[2] = v;
+        }
     }
     for (int i = 0; i < 3; ++i) {
         const double configured = fitted[i] > 0.0 ? fitted[i] : defaults[i];
@@ -201,6 +212,15 @@ int Firmware::push_ref(const pyins_ref& ref) {
 
 void Firmware::skip_ref(const pyins_ref& ref) {
     count(&n_ref_skipped_[ref.kind - 1], 1u);
+    if (mode_ == Mode::kCoarseAlign && coarse_.prm.method == static_cast<int32_t>(coarse_align::Method::kFitVel)) {
+        // under way: the velocity is the alignment's measurement, its tick
+        // counted from the alignment's start (tick_ - coarse_.tick)
+        if (ref.kind == PYINS_REF_GNSS_VEL) {
+            const double sigma = ref.sigma[0] > ref.sigma[1] ? ref.sigma[0] : ref.sigma[1];
+            coarse_align::reference(coarse_, ref.value[0], ref.value[1], sigma, ref.tick - (tick_ - coarse_.tick));
+        }
+        return;
+    }
     if ((mode_ != Mode::kCoarseAlign && mode_ != Mode::kFineAlign) ||
         (ref.kind != PYINS_REF_GNSS_VEL && ref.kind != PYINS_REF_DVL)) {
         return;

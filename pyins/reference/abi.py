@@ -86,6 +86,7 @@ PYINS_INDEX_FAULT = 3
 PYINS_COARSE_TRIAD = 0
 PYINS_COARSE_FIT = 1
 PYINS_COARSE_EQ8 = 2
+PYINS_COARSE_FIT_VEL = 3
 
 # --- enum pyins_fine_correction ---------------------------------------------
 PYINS_FINE_FEEDBACK = 0
@@ -152,7 +153,8 @@ ENUMS = {
         ("pyins_index_kind", ["PYINS_INDEX_FIXED", "PYINS_INDEX_FLEX_COS", "PYINS_INDEX_FLEX_SIN"]),
         ("pyins_index_state", ["PYINS_INDEX_IDLE", "PYINS_INDEX_STOP", "PYINS_INDEX_MOVE",
                                "PYINS_INDEX_FAULT"]),
-        ("pyins_coarse_method", ["PYINS_COARSE_TRIAD", "PYINS_COARSE_FIT", "PYINS_COARSE_EQ8"]),
+        ("pyins_coarse_method", ["PYINS_COARSE_TRIAD", "PYINS_COARSE_FIT", "PYINS_COARSE_EQ8",
+                                 "PYINS_COARSE_FIT_VEL"]),
         ("pyins_fine_correction", ["PYINS_FINE_FEEDBACK", "PYINS_FINE_OPEN_LOOP"]),
         ("pyins_fine_noise", ["PYINS_FINE_NOISE_MEASURED", "PYINS_FINE_NOISE_CONFIGURED"]),
         ("pyins_fault_flag", [n for n in dir() if n.startswith("PYINS_FAULT_")]),

@@ -75,6 +75,11 @@ def _build_base_motion(m):
         yaw0, speed0, legs = voyage.voyage_segments(m["duration_s"] / 3600.0, seed=m["route_seed"], dt=DT)
         if m["yaw_rad"] is not None:
             yaw0 = m["yaw_rad"]
+        if m.get("speed_mps") is not None:
+            speed0 = m["speed_mps"]
+        if m.get("segments") is not None:         # a chosen track instead of the route's
+            legs = [sim.Segment(s["kind"], round(s["duration_s"] * TICK_HZ), s["value"])
+                    for s in m["segments"]]
         current = None
         if any(m["current_mps"]) or m["current_tide_mps"]:
             current = references.Current(mean_enu=m["current_mps"], amplitude_mps=m["current_tide_mps"],

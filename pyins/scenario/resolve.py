@@ -88,6 +88,19 @@ def _resolve_motion(table, duration_s):
             raise ScenarioError(str(exc), "motion.lever_p") from None
     if kind == "voyage":
         res["duration_s"] = duration_s      # the route is cut there (a longer one extends it)
+        # the chosen track's keys only when given: a route's file keeps its digest
+        if res["speed_mps"] is None:
+            del res["speed_mps"]
+        if v["segments"] == "route":
+            del res["segments"]
+        else:
+            if v["segments"] == "default":
+                raise ScenarioError("must be 'route' or an array of legs, got 'default'", "motion.segments")
+            res["segments"] = _resolve_segments(v["segments"])
+            length = _build_motion(res).duration
+            if length + 1e-9 < duration_s:
+                raise ScenarioError(f"the legs last {length:g} s, shorter than the duration "
+                                    f"{duration_s:g} s", "motion.segments")
         if res["current_mps"][2] != 0.0:
             raise ScenarioError("the current is horizontal: give [E, N, 0] (its up component must be 0)",
                                 "motion.current")
@@ -431,6 +444,18 @@ def _resolve(data, stem):
     if firmware["nav_mode"] is None:
         del firmware["nav_mode"]
     references = _resolve_references(data.get("references", {}), duration_s, firmware)
+    if firmware.get("coarse_method") == "fit_vel" and firmware["coarse_time_s"]:
+        # under way: the GNSS velocity is the coarse alignment's measurement, the
+        # navigation filter its fine alignment
+        if firmware["fine_time_s"]:
+            raise ScenarioError("coarse_method 'fit_vel' (under way) is followed by the navigation "
+                                "filter, not a fine alignment: leave fine_time out", "firmware.fine_time")
+        if firmware.get("nav_mode") == "undamped":
+            raise ScenarioError("coarse_method 'fit_vel' (under way) needs the navigation filter: "
+                                "nav_mode 'undamped' has none", "firmware.nav_mode")
+        if "gnss" not in references:
+            raise ScenarioError("coarse_method 'fit_vel' (under way) takes the ship's motion from a GNSS "
+                                "velocity: give [references.gnss]", "firmware.coarse_method")
     res = {
         "schema": SCHEMA_VERSION,
         "name": name,

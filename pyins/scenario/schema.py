@@ -125,6 +125,10 @@ MOTION_KINDS = {
         "sea": Key("choice", "the swing of seed 000 Table 2 on top of the track ('none': a flat sea); "
                              "the voyage heaves 0.5 m at 8 s", "general",
                    choices=("general", "ideal", "bad", "none")),
+        "speed": Key("velocity", "initial speed through the water (default: the route's, 8-16 kn)", None,
+                     lo="0 m/s", hi="100 m/s"),
+        "segments": Key("tables", "'route' (route_seed's transit) or legs {kind, duration, speed | "
+                                  "angle} as the manoeuvre's: a chosen track under the same sea", "route"),
         "current": Key("velocity", "the water current the ship drifts with, mean [E, N, 0] (its ground "
                                    "velocity: the water velocity along the bow plus the current)", "0 m/s",
                        lo="-10 m/s", hi="10 m/s", shape=3),
@@ -260,7 +264,8 @@ NAV_MODES = {"auto": abi.PYINS_NAV_AUTO, "undamped": abi.PYINS_NAV_UNDAMPED,
 VERTICAL_MODES = {"hold": abi.PYINS_VERTICAL_HOLD, "free": abi.PYINS_VERTICAL_FREE}
 FINE_CORRECTIONS = {"feedback": abi.PYINS_FINE_FEEDBACK, "open_loop": abi.PYINS_FINE_OPEN_LOOP}
 FINE_NOISES = {"measured": abi.PYINS_FINE_NOISE_MEASURED, "configured": abi.PYINS_FINE_NOISE_CONFIGURED}
-COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT, "eq8": abi.PYINS_COARSE_EQ8}
+COARSE_METHODS = {"triad": abi.PYINS_COARSE_TRIAD, "fit": abi.PYINS_COARSE_FIT, "eq8": abi.PYINS_COARSE_EQ8,
+                  "fit_vel": abi.PYINS_COARSE_FIT_VEL}
 FIRMWARE_KEYS = {
     "initial_attitude": Key("choice", "attitude the firmware starts from: the true one (plus "
                                       "[initial_errors]) or all Euler angles zero", "truth",
@@ -275,8 +280,10 @@ FIRMWARE_KEYS = {
     "coarse_output_every": _time("coarse solution interval (firmware default 1 s)", None,
                                  lo="0.01 s"),
     "coarse_method": Key("choice", "coarse alignment: 'triad' (seed 000, a base that does not move) "
-                                   "'fit' (moving base: heave, surge, sway) or 'eq8' (seed 000 "
-                                   "eq. 8 as printed, not orthonormalised; firmware default triad)", choices=tuple(COARSE_METHODS)),
+                                   "'fit' (moving base: heave, surge, sway), 'fit_vel' (a ship under way: "
+                                   "FIT with the motion taken out by [references.gnss]' velocity; the "
+                                   "navigation filter then aligns finely, so no fine_time) or 'eq8' "
+                                   "(seed 000 eq. 8 as printed, not orthonormalised; firmware default triad)", choices=tuple(COARSE_METHODS)),
     "lever": Key("choice", "lever arms the firmware is told: 'configured' (the simulated "
                            "motion.lever_b and lever_p) or 'unknown' (zero)", "configured",
                  choices=("configured", "unknown")),

@@ -229,7 +229,21 @@ int main(void) {
         g.lever_p_m[2] = -100.0;
         check_status(pyins_config_check(&g), PYINS_OK, "sensor offset of exactly 100 m accepted");
     }
-    BAD_CFG(b.coarse_method = 3, PYINS_E_CONFIG_COARSE_METHOD, "unknown coarse method");
+    BAD_CFG(b.coarse_method = 4, PYINS_E_CONFIG_COARSE_METHOD, "unknown coarse method");
+    /* under way the navigation filter aligns finely: no static fine filter, no UNDAMPED */
+    BAD_CFG((b.coarse_method = PYINS_COARSE_FIT_VEL, b.coarse_ticks = 12000, b.fine_ticks = 6000),
+            PYINS_E_CONFIG_COARSE_METHOD, "FIT_VEL with a fine alignment");
+    BAD_CFG((b.coarse_method = PYINS_COARSE_FIT_VEL, b.coarse_ticks = 12000, b.fine_ticks = 0,
+             b.nav_mode = PYINS_NAV_UNDAMPED),
+            PYINS_E_CONFIG_COARSE_METHOD, "FIT_VEL navigating undamped");
+    {
+        pyins_config g;
+        pyins_config_default(&g);
+        g.coarse_method = PYINS_COARSE_FIT_VEL;
+        g.coarse_ticks = 12000;
+        g.fine_ticks = 0;
+        check_status(pyins_config_check(&g), PYINS_OK, "FIT_VEL into the navigation filter accepted");
+    }
     {
         pyins_config g;
         pyins_config_default(&g);

@@ -328,7 +328,7 @@ def test_snapshot_carries_the_sequence_state():
     fw = native.Firmware(SEQ)
     fw.run(cut[:60])
     blob = fw.snapshot()
-    assert int.from_bytes(blob[4:8], "little") == 8      # snapshot format 8 (the filter's scale-factor and misalignment states, ABI 0.19)
+    assert int.from_bytes(blob[4:8], "little") == 9      # snapshot format 9 (the coarse alignment under way, ABI 0.20)
     rest = native.Firmware.from_snapshot(blob).run(cut[60:])
     whole = native.Firmware(SEQ).run(cut)
     assert rest.tobytes() == whole[60:].tobytes()

@@ -25,7 +25,8 @@ BUILTINS = ["demo", "seed000_static", "seed000_swing", "seed001_fine5", "seed001
             "harbour_ranging",                                                  # test_harbour_ranging.py
             "voyage_gnss", "voyage_gnss_outages", "voyage_log", "voyage_dvl",   # tests/atsea/test_scenario_refs.py
             "pier_indexed", "moored_indexed",                                   # tests/physics/test_indexed_alignment.py
-            "at_anchor"]                                                        # tests/physics/test_anchor_alignment.py
+            "at_anchor",                                                        # tests/physics/test_anchor_alignment.py
+            "under_way"]                                                        # tests/physics/test_underway_alignment.py
 
 
 def _tool(name):
