@@ -83,6 +83,16 @@ double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]);
 /* coarse_align: seed 000 eq. 8 as printed (row-major C_ib0^i) */
 void pyins_t_coarse_solve_eq8(const double vi1[3], const double vi2[3], const double vb1[3],
                               const double vb2[3], double m[9]);
+/* coarse_align under way (FIT_VEL): C_e^n at the reference point (row-major), g up^i + C_n^i (w_ie^n x v)
+ * and C_n^i v at time t, the solution from v^ib0 (grid, n x 3) and the i side (grid_i, n x 3; n at
+ * most 256), the heading sigma */
+void pyins_t_coarse_mat_n_e_at(double sin_lat, double cos_lat, double sin_dlon, double cos_dlon, double m[9]);
+void pyins_t_coarse_known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
+                                  double gravity, double ve, double vn, double out[3]);
+void pyins_t_coarse_ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
+                              double ve, double vn, double out[3]);
+void pyins_t_coarse_solve_vel_grid(const double *grid, const double *grid_i, int32_t n, double m[9]);
+double pyins_t_coarse_heading_sigma(int32_t n, double t_step, double var, double gravity, double cos_lat);
 
 /* moving_align: n ticks of dv_sf_n (n x 3) and z (n x 2, read at the update
  * ticks); writes x (12) and P (144, row-major); returns the number of

@@ -227,6 +227,35 @@ double pyins_t_coarse_rotation_sine(const double a[9], const double b[9]) {
     return pyins::coarse_align::rotation_sine(m9(a), m9(b));
 }
 
+void pyins_t_coarse_mat_n_e_at(double sin_lat, double cos_lat, double sin_dlon, double cos_dlon, double m[9]) {
+    put9(pyins::coarse_align::mat_n_e_at(sin_lat, cos_lat, sin_dlon, cos_dlon), m);
+}
+
+void pyins_t_coarse_known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
+                                  double gravity, double ve, double vn, double out[3]) {
+    put3(pyins::coarse_align::known_force_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, gravity, ve, vn), out);
+}
+
+void pyins_t_coarse_ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
+                              double ve, double vn, double out[3]) {
+    put3(pyins::coarse_align::ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn), out);
+}
+
+void pyins_t_coarse_solve_vel_grid(const double* grid, const double* grid_i, int32_t n, double m[9]) {
+    pyins::Vec3 g[pyins::coarse_align::kHistLen];
+    pyins::Vec3 gi[pyins::coarse_align::kHistLen];
+    const int32_t k_max = n < pyins::coarse_align::kHistLen ? n : pyins::coarse_align::kHistLen;
+    for (int32_t k = 0; k < k_max; ++k) {
+        g[k] = v3(grid + 3 * k);
+        gi[k] = v3(grid_i + 3 * k);
+    }
+    put9(pyins::coarse_align::solve_vel_grid(g, gi, k_max), m);
+}
+
+double pyins_t_coarse_heading_sigma(int32_t n, double t_step, double var, double gravity, double cos_lat) {
+    return pyins::coarse_align::heading_sigma(n, t_step, var, gravity, cos_lat);
+}
+
 namespace {
 pyins::moving_align::Params moving_params(const pyins_t_moving_params* p) {
     pyins::moving_align::Params prm;

@@ -117,8 +117,8 @@
 // The reference's antenna sits at l^b from the reference point: it moves at
 // v + d/dt (C_b^n l^b), and C_n^i d/dt(C_b^n l) = d/dt (C_b^i l) less
 // w_in x terms of 1e-4 m/s; C_b^i l^b = C_ib0^i C_p^ib0 C_b^p l^b, so that
-// term moves to the ib0 side: the grid holds v^ib0 + C_p^ib0 (C_b^p l^b)
-// (ref_lever_p, passed to update()). The reference's vertical velocity
+// term's derivative moves to the ib0 side: the grid holds v^ib0 + C_p^ib0 u
+// with u = (w_ip^p - alpha' z) x C_b^p l^b (ref_lever_p, passed to update()). The reference's vertical velocity
 // (heave) is not taken: its part, C up^i v_U, is a wave's bounded velocity,
 // which the weights (smooth over the alignment) do not pick up. Integrity:
 // the longest interval without a reference (ref_gap, from t0) is kept; the
@@ -275,8 +275,8 @@ void init(CoarseAlign& a, const Params& prm);
 
 /// Take one sample; solves C_ib0^i at the output ticks. lever_vel_p: u^p at
 /// the end of the tick [m/s] (read only with prm.lever); ref_lever_p: the
-/// reference's antenna from the reference point in p, C_b^p l^b [m] (read
-/// only by FIT_VEL).
+/// reference's antenna's velocity from the reference point in p, d/dt
+/// (C_p^i C_b^p l^b) in p [m/s] (read only by FIT_VEL).
 void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& lever_vel_p,
             const Vec3& ref_lever_p);
 

@@ -279,6 +279,12 @@ Vec3 Firmware::gnss_lever_p() const {
     return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
 }
 
+Vec3 Firmware::gnss_lever_vel_p() const {
+    // d/dt (C_p^i Rz^T l) in p: (w_ip^p - alpha' z) x Rz(alpha)^T gnss_lever_b, as lever_vel_for
+    const Vec3 w_b = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
+    return attitude::cross(w_b, gnss_lever_p());
+}
+
 Vec3 Firmware::lever_p() const {
     return lever_b_in_p() + Vec3(cfg_.lever_p_m[0], cfg_.lever_p_m[1], cfg_.lever_p_m[2]);
 }
@@ -824,7 +830,7 @@ PYINS_HOT_INLINE void Firmware::advance(const Vec3& dtheta_p, const Vec3& dv_p, 
     //    alignment, or navigation with the indexing cycle.
     if (mode_ == Mode::kCoarseAlign) {
         coarse_align::update(coarse_, dtheta_p, dv_p,
-                             has_lever_ != 0 ? lever_vel_p() : Vec3::Zero(), gnss_lever_p());
+                             has_lever_ != 0 ? lever_vel_p() : Vec3::Zero(), gnss_lever_vel_p());
         // under way the noise's own wander is allowed (coarse_align.hpp, "Under way")
         double wander_max = coarse_wander_max_;
         const double noise_wander = coarse_align::kWanderSigmas * coarse_.settle_sigma;

@@ -247,6 +247,8 @@ class Firmware {
     Vec3 lever_b_in_p() const;
     /// Rz(alpha)^T gnss_lever_b: the GNSS antenna from the reference point, in p [m].
     Vec3 gnss_lever_p() const;
+    /// Its velocity from the reference point, inertial derivative, in p [m/s].
+    Vec3 gnss_lever_vel_p() const;
     /// r^p = Rz(alpha)^T lever_b + lever_p: reference point -> accelerometers, in p [m].
     Vec3 lever_p() const;
     /// u^p for the rates given (linear in them).

@@ -3,7 +3,11 @@
 Mirrors ``csrc/src/coarse_align.{hpp,cpp}``; the header explains the method,
 the sign of eq. 5, the TRIAD construction that replaces eq. 8 (and eq. 8 as
 printed, method EQ8), the lever-arm
-velocity it removes and the moving-base method FIT.
+velocity it removes, the moving-base method FIT and the method under way
+FIT_VEL (the ship's motion taken out by GNSS velocity references). FIT_VEL's
+grid: C++ holds v^ib0 in grid[0 .. kFitVelLen - 1] and the i side in
+grid[kFitVelLen ..]; here ``grid`` and ``grid_i``, two lists of the same
+length, capped at FIT_VEL_LEN points.
 """
 import math
 from dataclasses import dataclass, field
@@ -17,6 +21,9 @@ HIST_LEN = 256  #: kHistLen
 METHOD_TRIAD = 0       #: Method::kTriad (PYINS_COARSE_TRIAD)
 METHOD_FIT = 1         #: Method::kFit (PYINS_COARSE_FIT)
 METHOD_EQ8 = 2         #: Method::kEq8 (PYINS_COARSE_EQ8)
+METHOD_FIT_VEL = 3     #: Method::kFitVel (PYINS_COARSE_FIT_VEL)
+FIT_VEL_LEN = HIST_LEN // 2   #: kFitVelLen: FIT_VEL's grid capacity (points)
+WANDER_SIGMAS = 4.0    #: kWanderSigmas: FIT_VEL's wander test, in its heading sigmas
 FIT_MIN_INTERVALS = 8  #: kFitMinIntervals
 
 
@@ -33,6 +40,9 @@ class Params:
     gravity: float
     settle_from: int = 0
     noise_every: int = 0
+    ref_gap_max: int = 0   #: FIT_VEL: the longest interval without a reference it trusts [ticks]
+    rm_h: float = 0.0      #: FIT_VEL: R_M + h at the site [m]
+    rn_h: float = 0.0      #: FIT_VEL: R_N + h at the site [m]
 
 
 NOISE_MIN_SAMPLES = 50   #: kNoiseMinSamples
@@ -59,6 +69,21 @@ class CoarseAlign:
     noise_seen: int = 0
     noise_sum: float = 0.0
     noise_n: int = 0
+    # Under way (FIT_VEL; coarse_align.hpp, "Under way")
+    grid_i: list = field(default_factory=lambda: [np.zeros(3)])   #: the i side on the grid points
+    ref_done: int = 0        #: grid points whose i side is complete
+    ref_count: int = 0       #: references taken (capped at 2^30)
+    dlat: float = 0.0        #: the reference point's latitude since t0 [rad]
+    dlon: float = 0.0        #: its longitude since t0 [rad]
+    ref_vel: list = field(default_factory=lambda: [0.0, 0.0])   #: the last reference velocity (E, N)
+    ref_tick: int = -1       #: its tick, counted as tick is (-1: none yet)
+    ref_gap: int = 0         #: the longest interval without a reference so far [ticks]
+    known_f: np.ndarray = field(default_factory=lambda: np.zeros(3))   #: g up^i + C_n^i (w_ie^n x v)
+    known_v: np.ndarray = field(default_factory=lambda: np.zeros(3))   #: its integral, K [m/s]
+    ref_cv: np.ndarray = field(default_factory=lambda: np.zeros(3))    #: C_n^i v at t_ref [m/s]
+    ref_var: float = 0.0     #: sum of the references' horizontal variances [m^2/s^2]
+    sigma_heading: float = 0.0   #: the latest solution's heading sigma [rad]
+    settle_sigma: float = 0.0    #: sigma_heading of the wander test's first solution [rad]
 
 
 def vel_i(t, sin_lat, cos_lat, gravity):
@@ -121,9 +146,9 @@ def fit_weights(s):
     return phi_a, phi_b
 
 
-def solve_fit(grid, n, t_step, sin_lat, cos_lat, gravity):
-    """C_ib0^i by FIT from P^ib0 on the grid points 0 .. n - 1 (mirrors
-    solve_fit: the weights made exactly orthogonal to 1 and s on the grid)."""
+def fit_sums(grid, grid_i, n, t_step, sin_lat, cos_lat, gravity):
+    """FIT's weighted sums (mirrors fit_sums): the i side from grid_i, or by
+    pos_i where grid_i is None."""
     k_end = n - 1
     inv_k = 1.0 / float(k_end)
     ia, ib, ba, bb = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
@@ -132,7 +157,7 @@ def solve_fit(grid, n, t_step, sin_lat, cos_lat, gravity):
     for k in range(0, k_end + 1):
         s = float(k) * inv_k
         wa, wb = fit_weights(s)
-        pi = pos_i(float(k) * t_step, sin_lat, cos_lat, gravity)
+        pi = grid_i[k] if grid_i is not None else pos_i(float(k) * t_step, sin_lat, cos_lat, gravity)
         pb = grid[k]
         ia = ia + wa * pi
         ib = ib + wb * pi
@@ -161,9 +186,111 @@ def solve_fit(grid, n, t_step, sin_lat, cos_lat, gravity):
     return solve_mat_i_ib0(ib, ia, bb, ba)
 
 
+def solve_fit(grid, n, t_step, sin_lat, cos_lat, gravity):
+    """C_ib0^i by FIT from P^ib0 on the grid points 0 .. n - 1 (mirrors
+    solve_fit: the weights made exactly orthogonal to 1 and s on the grid)."""
+    return fit_sums(grid, None, n, t_step, sin_lat, cos_lat, gravity)
+
+
+def solve_vel_grid(grid, grid_i, n):
+    """FIT_VEL: C_ib0^i from v^ib0 (grid) and the i side (grid_i) on the grid
+    points 0 .. n - 1 by the Legendre weights s - 1/2 and s^2 - s + 1/6 made
+    exact on the grid (mirrors solve_vel_grid)."""
+    k_end = n - 1
+    inv_k = 1.0 / float(k_end)
+    ia, ib, ba, bb = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    i0, b0 = np.zeros(3), np.zeros(3)
+    s1 = s2 = s3 = 0.0
+    for k in range(0, k_end + 1):
+        s = float(k) * inv_k
+        ss = s * s
+        vi = grid_i[k]
+        vb = grid[k]
+        ia = ia + s * vi
+        ib = ib + ss * vi
+        ba = ba + s * vb
+        bb = bb + ss * vb
+        i0 = i0 + vi
+        b0 = b0 + vb
+        s1 = s1 + s
+        s2 = s2 + ss
+        s3 = s3 + ss * s
+    s0 = float(n)
+    # psi_a = s - s1 / n; psi_b = s^2 - alpha - beta s, [n s1; s1 s2] [alpha; beta] = [s2; s3]
+    mean_s = s1 / s0
+    det = s0 * s2 - s1 * s1
+    alpha = (s2 * s2 - s1 * s3) / det
+    beta = (s0 * s3 - s1 * s2) / det
+    ib = ib - alpha * i0 - beta * ia
+    bb = bb - alpha * b0 - beta * ba
+    ia = ia - mean_s * i0
+    ba = ba - mean_s * b0
+    # anchored on the gravity pair (psi_a), turned about it by the Earth-rate pair
+    return solve_mat_i_ib0(ib, ia, bb, ba)
+
+
+def heading_sigma(n, t_step, var, gravity, cos_lat):
+    """FIT_VEL: the heading sigma of a solution on n grid points t_step [s]
+    apart from references of mean variance var [m^2/s^2] [rad] (mirrors
+    heading_sigma): sigma / sqrt(sum q_k^2) / (g cos L Omega / 2), q the
+    grid's quadratic orthogonal to 1 and t."""
+    s1 = s2 = s3 = s4 = 0.0
+    for k in range(0, n):
+        t = float(k) * t_step
+        tt = t * t
+        s1 = s1 + t
+        s2 = s2 + tt
+        s3 = s3 + tt * t
+        s4 = s4 + tt * tt
+    s0 = float(n)
+    det = s0 * s2 - s1 * s1
+    alpha = (s2 * s2 - s1 * s3) / det
+    beta = (s0 * s3 - s1 * s2) / det
+    # sum q^2 = sum q t^2 (q is orthogonal to 1 and t) = s4 - alpha s2 - beta s3
+    qq = s4 - alpha * s2 - beta * s3
+    return math.sqrt(var / qq) / (0.5 * gravity * cos_lat * earth.OMEGA_IE)
+
+
 def mat_n_e(sin_lat, cos_lat):
     """C_e^n, e's x axis on the site meridian (seed 000 eq. 2)."""
     return np.array([[0.0, 1.0, 0.0], [-sin_lat, 0.0, cos_lat], [cos_lat, 0.0, sin_lat]])
+
+
+def mat_n_e_at(sin_lat, cos_lat, sin_dlon, cos_dlon):
+    """FIT_VEL: C_e^n at the reference point (rows E, N, U in e; dlon from the
+    site meridian): mat_n_e's rows turned by dlon about z (mirrors mat_n_e_at)."""
+    return np.array([[-sin_dlon, cos_dlon, 0.0],
+                     [-sin_lat * cos_dlon, -sin_lat * sin_dlon, cos_lat],
+                     [cos_lat * cos_dlon, cos_lat * sin_dlon, sin_lat]])
+
+
+def e_to_i(t, x):
+    """C_e^i(t) x = Rz(w t) x (mirrors e_to_i)."""
+    s = math.sin(earth.OMEGA_IE * t)
+    c = math.cos(earth.OMEGA_IE * t)
+    return np.array([c * x[0] - s * x[1], s * x[0] + c * x[1], x[2]])
+
+
+def n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, xe, xn, xu):
+    """C_n^e x for n at (lat, dlon): x_E E + x_N N + x_U U (mirrors n_to_e)."""
+    return np.array([-sin_dlon * xe - sin_lat * cos_dlon * xn + cos_lat * cos_dlon * xu,
+                     cos_dlon * xe - sin_lat * sin_dlon * xn + cos_lat * sin_dlon * xu,
+                     cos_lat * xn + sin_lat * xu])
+
+
+def known_force_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, gravity, ve, vn):
+    """FIT_VEL: g up^i + C_n^i (w_ie^n x v) at time t for the reference point at
+    (lat, dlon) moving at v (E, N) [m/s^2] (mirrors known_force_i)."""
+    w = earth.OMEGA_IE
+    ce = -w * sin_lat * vn
+    cn = w * sin_lat * ve
+    cu = -w * cos_lat * ve + gravity
+    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ce, cn, cu))
+
+
+def ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn):
+    """FIT_VEL: C_n^i v at time t [m/s] (mirrors ref_vel_i)."""
+    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, 0.0))
 
 
 def mat_e_i(t):
@@ -185,7 +312,10 @@ def rotation_sine(a, b):
 
 
 def init(prm):
-    return CoarseAlign(prm=prm)
+    a = CoarseAlign(prm=prm)
+    a.grid_every = prm.output_every
+    a.known_f = known_force_i(0.0, prm.sin_lat, prm.cos_lat, 0.0, 1.0, prm.gravity, 0.0, 0.0)
+    return a
 
 
 def measured_vrw(a):
@@ -204,6 +334,7 @@ def settle(a):
     if not a.settling:
         a.settling = True
         a.settle_ref = a.mat_i_ib0.copy()
+        a.settle_sigma = a.sigma_heading
         return
     s = rotation_sine(a.settle_ref, a.mat_i_ib0)
     if s > a.wander:
@@ -226,10 +357,66 @@ def measure_noise(a, v):
     a.noise_v = [np.array(v, dtype=float), a.noise_v[0], a.noise_v[1]]
 
 
-def update(a, dtheta_p, dv_p, lever_vel_p=None):
+def ship_sincos(a):
+    """FIT_VEL: sin, cos of the reference point's latitude and of dlon now
+    (mirrors ship_sincos)."""
+    sd = math.sin(a.dlat)
+    cd = math.cos(a.dlat)
+    sin_lat = a.prm.sin_lat * cd + a.prm.cos_lat * sd
+    cos_lat = a.prm.cos_lat * cd - a.prm.sin_lat * sd
+    return sin_lat, cos_lat, math.sin(a.dlon), math.cos(a.dlon)
+
+
+def carry_known(a):
+    """FIT_VEL, once a tick after a.tick advanced: the reference point carried
+    by the last reference velocity, and K by the trapezoid rule (mirrors carry_known)."""
+    dt = a.prm.dt
+    sl, cl, sd, cd = ship_sincos(a)
+    a.dlat = a.dlat + a.ref_vel[1] * dt / a.prm.rm_h
+    a.dlon = a.dlon + a.ref_vel[0] * dt / (a.prm.rn_h * cl)
+    sl, cl, sd, cd = ship_sincos(a)
+    t = float(a.tick) * dt
+    f = known_force_i(t, sl, cl, sd, cd, a.prm.gravity, a.ref_vel[0], a.ref_vel[1])
+    a.known_v = a.known_v + (0.5 * dt) * (a.known_f + f)
+    a.known_f = f
+
+
+def reference(a, ve, vn, sigma, ref_tick):
+    """FIT_VEL: take a reference velocity (E, N) [m/s] with its sigma [m/s],
+    valid at alignment tick ref_tick (a.tick or earlier; one not newer than
+    the last is ignored): completes the grid points it covers (mirrors reference)."""
+    if ref_tick < 0 or ref_tick > a.tick or (a.ref_tick >= 0 and ref_tick <= a.ref_tick):
+        return   # before the alignment, ahead of it, or not newer than the last: not taken
+    dt = a.prm.dt
+    sl, cl, sd, cd = ship_sincos(a)
+    cv = ref_vel_i(float(ref_tick) * dt, sl, cl, sd, cd, ve, vn)
+    # the previous epoch: the last reference, or t0 with this velocity
+    first = a.ref_tick < 0
+    t_prev = 0 if first else a.ref_tick
+    cv_prev = cv if first else a.ref_cv
+    gap = ref_tick - t_prev
+    if gap > a.ref_gap:
+        a.ref_gap = gap
+    # the grid points in (t_prev, ref_tick]: the velocity linear in between
+    while a.ref_done < len(a.grid) and a.ref_done * a.grid_every <= ref_tick:
+        u = a.ref_done * a.grid_every - t_prev
+        frac = float(u) / float(gap) if gap > 0 else 0.0
+        a.grid_i[a.ref_done] = a.grid_i[a.ref_done] + cv_prev + frac * (cv - cv_prev)
+        a.ref_done = a.ref_done + 1
+    a.ref_vel = [float(ve), float(vn)]
+    a.ref_tick = ref_tick
+    a.ref_cv = cv
+    a.ref_var = a.ref_var + sigma * sigma
+    if a.ref_count < (1 << 30):
+        a.ref_count = a.ref_count + 1
+
+
+def update(a, dtheta_p, dv_p, lever_vel_p=None, ref_lever_p=None):
     """Take one sample; solve C_ib0^i at the output ticks (mirrors update).
 
-    lever_vel_p: u^p at the end of the tick [m/s] (read only with prm.lever).
+    lever_vel_p: u^p at the end of the tick [m/s] (read only with prm.lever);
+    ref_lever_p: the reference's antenna's velocity from the reference point
+    in p, (w_ip^p - alpha' z) x C_b^p l^b [m/s] (read only by FIT_VEL).
     """
     c = strapdown.compensate(dtheta_p, dv_p, a.hist)
     phi, dv_comp = c.phi, c.dv_p
@@ -246,21 +433,43 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
             a.lever_vel0 = np.array(lever_vel_p, dtype=float)
     if a.prm.noise_every > 0 and a.tick % a.prm.noise_every == 0:
         measure_noise(a, vel)
-    fit = a.prm.method == METHOD_FIT
-    if fit:
+    fit_vel = a.prm.method == METHOD_FIT_VEL
+    fit = a.prm.method == METHOD_FIT or fit_vel
+    if fit_vel:
+        carry_known(a)
+    if fit and not fit_vel:
         a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel)
         a.vel_prev = vel.copy()
 
     every = a.prm.output_every
     if a.grid_every == 0:
         a.grid_every = every
-    if fit and a.tick % a.grid_every == 0 and len(a.grid) == HIST_LEN:
+    cap = FIT_VEL_LEN if fit_vel else HIST_LEN
+    if fit and a.tick % a.grid_every == 0 and len(a.grid) == cap:
         # full: every other point at twice the spacing (mirrors update)
-        a.grid = a.grid[0:HIST_LEN:2]
+        a.grid = a.grid[0:cap:2]
+        if fit_vel:
+            a.grid_i = a.grid_i[0:cap:2]
+            a.ref_done = (a.ref_done + 1) // 2   # point k was 2k: complete if 2k < ref_done
         a.grid_every = 2 * a.grid_every
-    if a.tick % a.grid_every == 0 and len(a.grid) < HIST_LEN:
-        a.grid.append(a.pos_ib0.copy() if fit else vel.copy())
+    if a.tick % a.grid_every == 0 and len(a.grid) < cap:
+        if fit_vel:
+            # the antenna's lever on the ib0 side; K now, the reference's integral to come
+            a.grid.append(vel + attitude.quat_to_mat(a.quat_ib0_p) @ ref_lever_p)
+            a.grid_i.append(a.known_v.copy())
+        else:
+            a.grid.append(a.pos_ib0.copy() if fit else vel.copy())
     if a.tick >= a.prm.first_output and (a.tick - a.prm.first_output) % every == 0:
+        if fit_vel:
+            # the grid points a reference has completed (a reference interval behind)
+            if a.ref_done > FIT_MIN_INTERVALS:
+                a.mat_i_ib0 = solve_vel_grid(a.grid, a.grid_i, a.ref_done)
+                a.sigma_heading = heading_sigma(a.ref_done, float(a.grid_every) * a.prm.dt,
+                                                a.ref_var / float(a.ref_count), a.prm.gravity,
+                                                a.prm.cos_lat)
+                a.solved = True
+                settle(a)
+            return
         if fit:
             a.mat_i_ib0 = solve_fit(a.grid, len(a.grid), float(a.grid_every) * a.prm.dt,
                                     a.prm.sin_lat, a.prm.cos_lat, a.prm.gravity)
@@ -288,11 +497,14 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None):
 
 
 def mat_n_p(a):
-    """C_p^n now (seed 000 eq. 1); for EQ8 the rotation of the Euler angles read
-    off the product (mirrors mat_n_p). Precondition: a.solved."""
+    """C_p^n now (seed 000 eq. 1; FIT_VEL: with n at the reference point now);
+    for EQ8 the rotation of the Euler angles read off the product (mirrors
+    mat_n_p). Precondition: a.solved."""
     t = float(a.tick) * a.prm.dt
-    m = (mat_n_e(a.prm.sin_lat, a.prm.cos_lat) @ mat_e_i(t) @ a.mat_i_ib0
-         @ attitude.quat_to_mat(a.quat_ib0_p))
+    n_e = mat_n_e(a.prm.sin_lat, a.prm.cos_lat)
+    if a.prm.method == METHOD_FIT_VEL:
+        n_e = mat_n_e_at(*ship_sincos(a))
+    m = n_e @ mat_e_i(t) @ a.mat_i_ib0 @ attitude.quat_to_mat(a.quat_ib0_p)
     if a.prm.method == METHOD_EQ8:
         # seed 000: eq. 8's matrix into eq. 1, the attitude angles read off its elements
         return attitude.euler_to_mat(attitude.mat_to_euler(m))

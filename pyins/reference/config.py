@@ -57,6 +57,7 @@ REF_HORIZON_S = 10                           #: kRefHorizonS
 MAX_NAV_GYRO_BIAS_RW = 1e-6                  #: kMaxNavGyroBiasRw [rad/s/sqrt(s)]
 MAX_NAV_TABLE_SIGMA = 0.01                   #: kMaxNavTableSigma
 ALIGN_MAX_SPEED = 0.5                        #: kAlignMaxSpeed [m/s]
+COARSE_REF_GAP_S = 3                         #: kCoarseRefGapS: the longest gap in an alignment under way [s]
 NAV_SIGMA0_POS = 10.0                        #: kNavSigma0Pos [m]
 NAV_SIGMA0_VEL = 0.1                         #: kNavSigma0Vel [m/s]
 
@@ -280,7 +281,7 @@ def config_check(raw):
             return abi.PYINS_E_CONFIG_ALIGN_TICKS
         if cfg["coarse_ratio"] * float(cfg["coarse_first_output_ticks"]) < float(every):
             return abi.PYINS_E_CONFIG_ALIGN_EARLY
-        if (cfg["coarse_method"] != abi.PYINS_COARSE_FIT
+        if (cfg["coarse_method"] not in (abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_FIT_VEL)
                 and cfg["coarse_ticks"] // every > coarse_align.HIST_LEN - 1):
             return abi.PYINS_E_CONFIG_ALIGN_LONG
     if cfg["fine_ticks"] < 0:
@@ -312,9 +313,14 @@ def config_check(raw):
     for r in (cfg["lever_b_m"], cfg["lever_p_m"], cfg["dvl_lever_b_m"], cfg["gnss_lever_b_m"]):
         if not finite3(r) or r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > MAX_LEVER_M * MAX_LEVER_M:
             return abi.PYINS_E_CONFIG_LEVER
-    if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_EQ8):
+    if cfg["coarse_method"] not in (abi.PYINS_COARSE_TRIAD, abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_EQ8,
+                                    abi.PYINS_COARSE_FIT_VEL):
         return abi.PYINS_E_CONFIG_COARSE_METHOD
-    if (cfg["coarse_method"] == abi.PYINS_COARSE_FIT and cfg["coarse_ticks"] > 0
+    # under way the static fine filters cannot follow: the navigation filter aligns finely
+    if (cfg["coarse_method"] == abi.PYINS_COARSE_FIT_VEL and cfg["coarse_ticks"] > 0
+            and (cfg["fine_ticks"] > 0 or cfg["nav_mode"] == abi.PYINS_NAV_UNDAMPED)):
+        return abi.PYINS_E_CONFIG_COARSE_METHOD
+    if (cfg["coarse_method"] in (abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_FIT_VEL) and cfg["coarse_ticks"] > 0
             and cfg["coarse_first_output_ticks"] // cfg["coarse_output_every_ticks"]
             < coarse_align.FIT_MIN_INTERVALS):
         return abi.PYINS_E_CONFIG_ALIGN_EARLY

@@ -142,9 +142,13 @@ class Firmware(NavAtSea):
                 output_every=cfg["coarse_output_every_ticks"], dt=self.dt, sin_lat=sin_lat,
                 cos_lat=cos_lat, gravity=earth.normal_gravity(sin_lat, cfg["height_m"]),
                 settle_from=cfg["coarse_ticks"] - cfg["coarse_ticks"] // 5,
+                ref_gap_max=config.COARSE_REF_GAP_S * cfg["tick_hz"],
                 # the noise of the static fine filters' R (coarse_align, "Noise")
                 noise_every=(cfg["fine_meas_every_ticks"] if cfg["fine_ticks"] > 0 and cfg["fine_states"] != 12
                              and cfg["fine_noise"] == abi.PYINS_FINE_NOISE_MEASURED else 0))
+            rm, rn = earth.principal_radii(sin_lat)
+            prm.rm_h = rm + cfg["height_m"]
+            prm.rn_h = rn + cfg["height_m"]
             self.coarse = coarse_align.init(prm)
 
     def start_navigation(self):
@@ -205,9 +209,21 @@ class Firmware(NavAtSea):
         lb = self.lever_b
         return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
 
+    def gnss_lever_p(self):
+        """Rz(alpha)^T gnss_lever_b: the GNSS antenna from the reference point,
+        in p (mirrors gnss_lever_p, as lever_b_in_p)."""
+        sa, ca = self.encoder_sincos()
+        lb = self.cfg["gnss_lever_b_m"]
+        return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
+
     def lever_p(self):
         """r^p = Rz(alpha)^T lever_b + lever_p (mirrors Firmware::lever_p)."""
         return self.lever_b_in_p() + self.lever_pp
+
+    def gnss_lever_vel_p(self):
+        """(w_ip^p - alpha' z) x Rz^T gnss_lever_b (mirrors gnss_lever_vel_p)."""
+        w_b = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
+        return cross(w_b, self.gnss_lever_p())
 
     def lever_vel_p(self):
         """u^p at the last tick's rates (mirrors lever_vel_p)."""
@@ -278,14 +294,32 @@ class Firmware(NavAtSea):
             self.idx = indexing.reset(self.idx, self.table_angle)
 
     def end_coarse(self):
-        """Navigation starts from the coarse attitude, at rest, with its history."""
+        """Navigation starts from the coarse attitude, at rest, with its history;
+        under way where the references carried the reference point, at the last
+        one's velocity less its antenna's lever (mirrors end_coarse)."""
         nav = self.sd.nav
         nav = strapdown.NavState(nav.lat, nav.lon, nav.height, np.zeros(3),
                                  attitude.mat_to_quat(coarse_align.mat_n_p(self.coarse)))
+        lat = self.cfg["lat_rad"]
+        lon = self.sd.ref_lon
+        co = self.coarse
+        if co.prm.method == coarse_align.METHOD_FIT_VEL:
+            since = co.tick if co.ref_tick < 0 else co.tick - co.ref_tick
+            if co.ref_tick < 0 or co.ref_gap > co.prm.ref_gap_max or since > co.prm.ref_gap_max:
+                self.faults = self.faults | abi.PYINS_FAULT_ALIGN_INCONSISTENT
+                self.integrity_lost = 1
+            lat = lat + co.dlat
+            lon = wrap_pi(lon + co.dlon)
+            nav.lat = lat
+            nav.lon = lon
+            self.sd.nav = nav   # point_vel_n reads the latitude
+            lever_v = self.point_vel_n(attitude.quat_mul_z(nav.quat_np, self.enc_cos_half, -self.enc_sin_half),
+                                       self.cfg["gnss_lever_b_m"])
+            nav.vel_n = np.array([co.ref_vel[0] - lever_v[0], co.ref_vel[1] - lever_v[1], 0.0])
         self.sd = strapdown.make_strapdown(nav, self.sd.vertical)
         self.sd.hist = self.coarse.hist
         if self.has_lever:
-            self.place_imu(self.cfg["lat_rad"], self.sd.ref_lon, self.cfg["height_m"], np.zeros(3))
+            self.place_imu(lat, lon, self.cfg["height_m"], nav.vel_n)
         self.att_valid = True
         if self.cfg["fine_ticks"] > 0:
             self.start_fine()
@@ -559,8 +593,15 @@ class Firmware(NavAtSea):
         #    alignment, or navigation with the indexing cycle.
         if self.mode == abi.PYINS_MODE_COARSE_ALIGN:
             coarse_align.update(self.coarse, dtheta_p, dv_p,
-                                self.lever_vel_p() if self.has_lever else np.zeros(3))
-            if self.coarse.wander > self.coarse_wander_max:
+                                self.lever_vel_p() if self.has_lever else np.zeros(3), self.gnss_lever_vel_p())
+            # under way the noise's own wander is allowed (coarse_align.hpp, "Under way")
+            wander_max = self.coarse_wander_max
+            noise_wander = coarse_align.WANDER_SIGMAS * self.coarse.settle_sigma
+            if noise_wander >= 0.5 * np.pi:
+                wander_max = 1.0
+            elif math.sin(noise_wander) > wander_max:
+                wander_max = math.sin(noise_wander)
+            if self.coarse.wander > wander_max:
                 self.faults = self.faults | abi.PYINS_FAULT_COARSE_UNSETTLED
                 self.integrity_lost = 1
             if self.coarse.tick == self.cfg["coarse_ticks"]:

@@ -94,6 +94,14 @@ class NavAtSea:
             fine_align.sigma0_after_coarse(fp, float(cfg["coarse_ticks"]) * self.dt, self.coarse.wander,
                                            config.DEFAULT_FINE_SIGMA_ATT)
             fitted = fp.sigma0_att
+            if self.coarse.prm.method == coarse_align.METHOD_FIT_VEL and cfg["fine_sigma0_att_rad"][2] == 0.0:
+                # under way the reference velocity's noise adds its heading sigma
+                # (coarse_align.hpp, "Under way"), with the same margin
+                h = fine_align.AFTER_COARSE_MARGIN * self.coarse.sigma_heading
+                v = math.sqrt(fitted[2] * fitted[2] + h * h)
+                if v > config.DEFAULT_FINE_SIGMA_ATT[2]:
+                    v = config.DEFAULT_FINE_SIGMA_ATT[2]
+                fitted[2] = v
         att = np.zeros(3)
         for i in range(3):
             configured = fitted[i] if fitted[i] > 0.0 else config.DEFAULT_FINE_SIGMA_ATT[i]
@@ -322,8 +330,15 @@ class NavAtSea:
     def skip_ref(self, ref):
         """Counted as skipped; during an alignment a velocity that says the
         site moves ends its integrity (mirrors skip_ref)."""
-        kind, _, value, sigma = ref
+        kind, tick, value, sigma = ref
         self.n_ref_skipped[kind - 1] = count(self.n_ref_skipped[kind - 1])
+        if self.mode == abi.PYINS_MODE_COARSE_ALIGN and self.coarse.prm.method == coarse_align.METHOD_FIT_VEL:
+            # under way: the velocity is the alignment's measurement, its tick
+            # counted from the alignment's start (self.tick - coarse.tick)
+            if kind == abi.PYINS_REF_GNSS_VEL:
+                sig = sigma[0] if sigma[0] > sigma[1] else sigma[1]
+                coarse_align.reference(self.coarse, value[0], value[1], sig, tick - (self.tick - self.coarse.tick))
+            return
         if (self.mode not in (abi.PYINS_MODE_COARSE_ALIGN, abi.PYINS_MODE_FINE_ALIGN)
                 or kind not in (abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_DVL)):
             return
