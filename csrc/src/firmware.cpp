@@ -261,28 +261,22 @@ void Firmware::encoder_sincos(double* sin_alpha, double* cos_alpha) const {
     *cos_alpha = enc_cos_half_ * enc_cos_half_ - enc_sin_half_ * enc_sin_half_;
 }
 
-Vec3 Firmware::lever_b_in_p() const {
-    // Rz(alpha)^T lever_b, alpha = the encoder angle
+Vec3 Firmware::b_in_p(const double* lb) const {
+    // Rz(alpha)^T l, alpha = the encoder angle
     double sa;
     double ca;
     encoder_sincos(&sa, &ca);
-    const double* lb = cfg_.lever_b_m;
     return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
 }
 
-Vec3 Firmware::gnss_lever_p() const {
-    // Rz(alpha)^T gnss_lever_b, as lever_b_in_p
-    double sa;
-    double ca;
-    encoder_sincos(&sa, &ca);
-    const double* lb = cfg_.gnss_lever_b_m;
-    return Vec3(ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]);
+Vec3 Firmware::lever_b_in_p() const {
+    return b_in_p(cfg_.lever_b_m);
 }
 
 Vec3 Firmware::gnss_lever_vel_p() const {
     // d/dt (C_p^i Rz^T l) in p: (w_ip^p - alpha' z) x Rz(alpha)^T gnss_lever_b, as lever_vel_for
     const Vec3 w_b = rate_p_ - Vec3(0.0, 0.0, alpha_rate_);
-    return attitude::cross(w_b, gnss_lever_p());
+    return attitude::cross(w_b, b_in_p(cfg_.gnss_lever_b_m));
 }
 
 Vec3 Firmware::lever_p() const {

@@ -245,9 +245,10 @@ class Firmware {
     void encoder_sincos(double* sin_alpha, double* cos_alpha) const;
     /// Rz(alpha)^T lever_b: the table centre from the reference point, in p [m].
     Vec3 lever_b_in_p() const;
-    /// Rz(alpha)^T gnss_lever_b: the GNSS antenna from the reference point, in p [m].
-    Vec3 gnss_lever_p() const;
-    /// Its velocity from the reference point, inertial derivative, in p [m/s].
+    /// Rz(alpha)^T l: a vector l of the ship (b) in p.
+    Vec3 b_in_p(const double* l) const;
+    /// The GNSS antenna's velocity from the reference point, inertial
+    /// derivative, in p: (w_ip^p - alpha' z) x Rz(alpha)^T gnss_lever_b [m/s].
     Vec3 gnss_lever_vel_p() const;
     /// r^p = Rz(alpha)^T lever_b + lever_p: reference point -> accelerometers, in p [m].
     Vec3 lever_p() const;

@@ -203,18 +203,14 @@ class Firmware(NavAtSea):
         return (2.0 * self.enc_sin_half * self.enc_cos_half,
                 self.enc_cos_half * self.enc_cos_half - self.enc_sin_half * self.enc_sin_half)
 
-    def lever_b_in_p(self):
-        """Rz(alpha)^T lever_b (mirrors lever_b_in_p)."""
+    def b_in_p(self, lb):
+        """Rz(alpha)^T l: a vector of the ship in p (mirrors b_in_p)."""
         sa, ca = self.encoder_sincos()
-        lb = self.lever_b
         return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
 
-    def gnss_lever_p(self):
-        """Rz(alpha)^T gnss_lever_b: the GNSS antenna from the reference point,
-        in p (mirrors gnss_lever_p, as lever_b_in_p)."""
-        sa, ca = self.encoder_sincos()
-        lb = self.cfg["gnss_lever_b_m"]
-        return np.array([ca * lb[0] + sa * lb[1], -sa * lb[0] + ca * lb[1], lb[2]])
+    def lever_b_in_p(self):
+        """Rz(alpha)^T lever_b (mirrors lever_b_in_p)."""
+        return self.b_in_p(self.lever_b)
 
     def lever_p(self):
         """r^p = Rz(alpha)^T lever_b + lever_p (mirrors Firmware::lever_p)."""
@@ -223,7 +219,7 @@ class Firmware(NavAtSea):
     def gnss_lever_vel_p(self):
         """(w_ip^p - alpha' z) x Rz^T gnss_lever_b (mirrors gnss_lever_vel_p)."""
         w_b = self.rate_p - np.array([0.0, 0.0, self.alpha_rate])
-        return cross(w_b, self.gnss_lever_p())
+        return cross(w_b, self.b_in_p(self.cfg["gnss_lever_b_m"]))
 
     def lever_vel_p(self):
         """u^p at the last tick's rates (mirrors lever_vel_p)."""
