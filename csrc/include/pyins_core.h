@@ -226,7 +226,8 @@ enum pyins_nav_mode {
 enum pyins_ref_kind {
     PYINS_REF_GNSS_POS = 1,       /* value: [lat rad, lon rad, height m]; sigma: [E, N, U] m (U unused:
                                      the vertical channel is held) */
-    PYINS_REF_GNSS_VEL = 2,       /* value: ENU velocity m/s; sigma: per axis m/s (U unused) */
+    PYINS_REF_GNSS_VEL = 2,       /* value: ENU velocity m/s; sigma: per axis m/s (U read only by the
+                                     coarse alignment under way, where sigma[2] > 0: 0 = none) */
     PYINS_REF_SPEED_LOG = 3,      /* EM log: value[0] speed through water along the bow [m/s]; sigma[0]
                                      [m/s] (components 1, 2 not used): damps the horizontal channels */
     PYINS_REF_DVL = 4,            /* Doppler velocity log, bottom track (ABI 0.16): value: the velocity

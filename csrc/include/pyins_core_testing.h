@@ -90,7 +90,7 @@ void pyins_t_coarse_mat_n_e_at(double sin_lat, double cos_lat, double sin_dlon, 
 void pyins_t_coarse_known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
                                   double gravity, double ve, double vn, double out[3]);
 void pyins_t_coarse_ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
-                              double ve, double vn, double out[3]);
+                              double ve, double vn, double vu, double out[3]);
 void pyins_t_coarse_solve_vel_grid(const double *grid, const double *grid_i, int32_t n, double m[9]);
 double pyins_t_coarse_heading_sigma(int32_t n, double t_step, double var, double gravity, double cos_lat);
 

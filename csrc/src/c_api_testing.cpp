@@ -237,8 +237,8 @@ void pyins_t_coarse_known_force_i(double t, double sin_lat, double cos_lat, doub
 }
 
 void pyins_t_coarse_ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
-                              double ve, double vn, double out[3]) {
-    put3(pyins::coarse_align::ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn), out);
+                              double ve, double vn, double vu, double out[3]) {
+    put3(pyins::coarse_align::ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, vu), out);
 }
 
 void pyins_t_coarse_solve_vel_grid(const double* grid, const double* grid_i, int32_t n, double m[9]) {

@@ -272,8 +272,8 @@ Vec3 known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, do
 }
 
 Vec3 ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon, double ve,
-               double vn) {
-    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, 0.0));
+               double vn, double vu) {
+    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, vu));
 }
 
 Mat3 mat_e_i(double t) {
@@ -333,6 +333,8 @@ void init(CoarseAlign& a, const Params& prm) {
     a.noise_n = 0;
     a.ref_done = 0;    // even t0's i side waits for C_n^i v(t0)
     a.ref_count = 0;
+    a.grid_from = 0;
+    a.reserved_fv = 0;
     a.dlat = 0.0;
     a.dlon = 0.0;
     a.ref_vel[0] = 0.0;
@@ -425,7 +427,7 @@ void carry_known(CoarseAlign& a) {
 
 }  // namespace
 
-void reference(CoarseAlign& a, double ve, double vn, double sigma, int64_t ref_tick) {
+void reference(CoarseAlign& a, double ve, double vn, double vu, double sigma, int64_t ref_tick) {
     if (ref_tick < 0 || ref_tick > a.tick || (a.ref_tick >= 0 && ref_tick <= a.ref_tick)) {
         return;   // before the alignment, ahead of it, or not newer than the last: not taken
     }
@@ -435,9 +437,13 @@ void reference(CoarseAlign& a, double ve, double vn, double sigma, int64_t ref_t
     double sd;
     double cd;
     ship_sincos(a, &sl, &cl, &sd, &cd);
-    const Vec3 cv = ref_vel_i(static_cast<double>(ref_tick) * dt, sl, cl, sd, cd, ve, vn);
+    const Vec3 cv = ref_vel_i(static_cast<double>(ref_tick) * dt, sl, cl, sd, cd, ve, vn, vu);
     // the previous epoch: the last reference, or t0 with this velocity
     const bool first = a.ref_tick < 0;
+    if (first) {
+        // the points before it are left out of the fit
+        a.grid_from = static_cast<int32_t>((ref_tick + a.grid_every - 1) / a.grid_every);
+    }
     const int64_t t_prev = first ? 0 : a.ref_tick;
     const Vec3 cv_prev = first ? cv : a.ref_cv;
     const int64_t gap = ref_tick - t_prev;
@@ -491,6 +497,11 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
     const bool fit = a.prm.method == static_cast<int32_t>(Method::kFit) || fit_vel;
     if (fit_vel) {
         carry_known(a);
+        if (a.tick == 1) {
+            // t0's ib0 side: v^ib0(t0) = 0 less the accelerometers' lever
+            // velocity plus the antenna's (see the header)
+            a.grid[0] = a.prm.lever != 0 ? ref_lever_p - lever_vel_p : ref_lever_p;
+        }
     }
     if (fit && !fit_vel) {
         a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel);  // trapezoid
@@ -512,6 +523,7 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
                 a.grid[kFitVelLen + k] = a.grid[kFitVelLen + 2 * k];
             }
             a.ref_done = (a.ref_done + 1) / 2;   // point k was 2k: complete if 2k < ref_done
+            a.grid_from = (a.grid_from + 1) / 2; // and in the fit if 2k >= grid_from
         }
         a.hist_count = cap / 2;
         a.grid_every = 2 * a.grid_every;
@@ -529,9 +541,10 @@ void update(CoarseAlign& a, const Vec3& dtheta_p, const Vec3& dv_p, const Vec3& 
     if (a.tick >= a.prm.first_output && (a.tick - a.prm.first_output) % every == 0) {
         if (fit_vel) {
             // the grid points a reference has completed (a reference interval behind)
-            if (a.ref_done > kFitMinIntervals) {
-                a.mat_i_ib0 = solve_vel_grid(a.grid, a.grid + kFitVelLen, a.ref_done);
-                a.sigma_heading = heading_sigma(a.ref_done, static_cast<double>(a.grid_every) * a.prm.dt,
+            const int32_t n_fit = a.ref_done - a.grid_from;
+            if (n_fit > kFitMinIntervals) {
+                a.mat_i_ib0 = solve_vel_grid(a.grid + a.grid_from, a.grid + kFitVelLen + a.grid_from, n_fit);
+                a.sigma_heading = heading_sigma(n_fit, static_cast<double>(a.grid_every) * a.prm.dt,
                                                 a.ref_var / static_cast<double>(a.ref_count), a.prm.gravity,
                                                 a.prm.cos_lat);
                 a.solved = true;

@@ -112,17 +112,28 @@
 // and C_n^i v when the first reference at or after its tick comes (v linear
 // between references; ref_done counts the complete points; the solution
 // uses those, so it lags a reference interval, which C_ib0^i, a constant,
-// does not mind). Before the first reference the velocity is taken as that
-// reference's.
+// does not mind). The points before the first reference (their velocity
+// would be a guess) are left out of the fit (grid_from). At t0 the ib0 side
+// is the lever velocities' alone (the accelerometers' and the antenna's from
+// the reference point), taken from the first sample's rates: off by
+// |w'| dt / 2 |r|, millimetres per second.
 // The reference's antenna sits at l^b from the reference point: it moves at
 // v + d/dt (C_b^n l^b), and C_n^i d/dt(C_b^n l) = d/dt (C_b^i l) less
 // w_in x terms of 1e-4 m/s; C_b^i l^b = C_ib0^i C_p^ib0 C_b^p l^b, so that
 // term's derivative moves to the ib0 side: the grid holds v^ib0 + C_p^ib0 u
-// with u = (w_ip^p - alpha' z) x C_b^p l^b (ref_lever_p, passed to update()). The reference's vertical velocity
-// (heave) is not taken: its part, C up^i v_U, is a wave's bounded velocity,
-// which the weights (smooth over the alignment) do not pick up. Integrity:
-// the longest interval without a reference (ref_gap, from t0) is kept; the
-// firmware faults an alignment whose gap exceeded ref_gap_max ticks.
+// with u = (w_ip^p - alpha' z) x C_b^p l^b (ref_lever_p, passed to update()).
+// The reference's vertical velocity is taken where the receiver gives it
+// (sigma[2] > 0): it carries the heave and the vertical part of the
+// antenna's lever velocity, which the ib0 side holds whole. Without one
+// (NMEA's RMC has none) the heave and that part are left to the weights,
+// which are not tapered: a wave's velocity leaks in as about 1 / (omega T)
+// of it (not measured here: the simulated receiver gives the vertical).
+// The wander test expects the noise to move the solution: the firmware
+// allows a wander of kWanderSigmas times settle_sigma (the sigma of the
+// test's first solution) where that is more than integrity_coarse_rad.
+// Integrity: the longest interval without a reference (ref_gap, from t0)
+// is kept; the firmware faults an alignment whose gap exceeded ref_gap_max
+// ticks.
 //
 // Noise (for the fine alignment's R; docs/core.md, "Measurement noise of
 // the fine alignment"). The static fine filters measure the specific force
@@ -221,6 +232,8 @@ struct CoarseAlign {
     // Under way (FIT_VEL; see the header)
     int32_t ref_done;        ///< grid points whose i side is complete
     int32_t ref_count;       ///< references taken (capped at 2^30)
+    int32_t grid_from;       ///< the first grid point at or after the first reference: the fit's first
+    int32_t reserved_fv;     ///< (keeps the layout free of padding)
     double dlat;             ///< the reference point's latitude since t0 [rad]
     double dlon;             ///< its longitude since t0 [rad]
     double ref_vel[2];       ///< the last reference velocity (E, N) [m/s]
@@ -289,15 +302,15 @@ Mat3 mat_n_e_at(double sin_lat, double cos_lat, double sin_dlon, double cos_dlon
 Vec3 known_force_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon,
                    double gravity, double ve, double vn);
 
-/// FIT_VEL: C_n^i v at time t [m/s].
+/// FIT_VEL: C_n^i v at time t, v = (ve, vn, vu) [m/s].
 Vec3 ref_vel_i(double t, double sin_lat, double cos_lat, double sin_dlon, double cos_dlon, double ve,
-               double vn);
+               double vn, double vu);
 
-/// FIT_VEL: take a reference velocity (E, N) [m/s] of the reference point
-/// with its sigma (the larger of E, N) [m/s], valid at alignment tick
+/// FIT_VEL: take a reference velocity (E, N, U; U 0 where not measured)
+/// [m/s] with its sigma (the larger of E, N) [m/s], valid at alignment tick
 /// ref_tick (a.tick or earlier; one not newer than the last is ignored):
 /// completes the grid points it covers.
-void reference(CoarseAlign& a, double ve, double vn, double sigma, int64_t ref_tick);
+void reference(CoarseAlign& a, double ve, double vn, double vu, double sigma, int64_t ref_tick);
 
 /// FIT_VEL: C_ib0^i from v^ib0 (grid) and the i side (grid_i) on the grid
 /// points 0 .. n - 1 by the Legendre weights (see the header).

@@ -217,7 +217,10 @@ void Firmware::skip_ref(const pyins_ref& ref) {
         // counted from the alignment's start (tick_ - coarse_.tick)
         if (ref.kind == PYINS_REF_GNSS_VEL) {
             const double sigma = ref.sigma[0] > ref.sigma[1] ? ref.sigma[0] : ref.sigma[1];
-            coarse_align::reference(coarse_, ref.value[0], ref.value[1], sigma, ref.tick - (tick_ - coarse_.tick));
+            // the vertical where the receiver measured one (sigma[2] > 0, finite)
+            const double vu = ref.sigma[2] > 0.0 && std::isfinite(ref.sigma[2]) ? ref.value[2] : 0.0;
+            coarse_align::reference(coarse_, ref.value[0], ref.value[1], vu, sigma,
+                                    ref.tick - (tick_ - coarse_.tick));
         }
         return;
     }

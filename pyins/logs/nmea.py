@@ -15,7 +15,9 @@ Association, 2018; each field is comma-separated, ``$`` or ``!`` first,
   (simulator): not measurements.
 - ``$--RMC,hhmmss.ss,A,llll.ll,a,yyyyy.yy,a,sog,cog,ddmmyy,var,a[,m[,s]]``
   (recommended minimum specific GNSS data) -> gnss_vel: speed over ground
-  (knots) and course over ground (deg true) as east, north (up 0); status
+  (knots) and course over ground (deg true) as east, north (up 0, its
+  sigma 0: not measured, which the firmware's alignment under way reads
+  as no vertical velocity); status
   A only, mode (v2.3 on) not N (not valid), E (estimated), M (manual) or
   S (simulator). Its date dates the file. Its position is not read
   (GGA's has the height and the fix quality).
@@ -529,7 +531,7 @@ def read_nmea(path, utc_start, tick_hz, kinds=("gnss_pos", "gnss_vel", "speed_lo
         rows, dup = _first_per_epoch(rows)
         s, given = sig["vel_sigma"]
         parts.append((KIND_GNSS_VEL, [r[0] for r in rows], [(r[1], r[2], 0.0) for r in rows],
-                      [(s, s, s)] * len(rows), [opt["vel_sigma"] if given else "assumed"] * len(rows)))
+                      [(s, s, 0.0)] * len(rows), [opt["vel_sigma"] if given else "assumed"] * len(rows)))
         taken["gnss_vel"] = what
         if rmc and vtg:
             facts["vtg_not_used"] = len(vtg)

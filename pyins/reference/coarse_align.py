@@ -73,6 +73,7 @@ class CoarseAlign:
     grid_i: list = field(default_factory=lambda: [np.zeros(3)])   #: the i side on the grid points
     ref_done: int = 0        #: grid points whose i side is complete
     ref_count: int = 0       #: references taken (capped at 2^30)
+    grid_from: int = 0       #: the first grid point at or after the first reference: the fit's first
     dlat: float = 0.0        #: the reference point's latitude since t0 [rad]
     dlon: float = 0.0        #: its longitude since t0 [rad]
     ref_vel: list = field(default_factory=lambda: [0.0, 0.0])   #: the last reference velocity (E, N)
@@ -288,9 +289,9 @@ def known_force_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, gravity, ve, vn):
     return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ce, cn, cu))
 
 
-def ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn):
-    """FIT_VEL: C_n^i v at time t [m/s] (mirrors ref_vel_i)."""
-    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, 0.0))
+def ref_vel_i(t, sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, vu):
+    """FIT_VEL: C_n^i v at time t, v = (ve, vn, vu) [m/s] (mirrors ref_vel_i)."""
+    return e_to_i(t, n_to_e(sin_lat, cos_lat, sin_dlon, cos_dlon, ve, vn, vu))
 
 
 def mat_e_i(t):
@@ -381,17 +382,20 @@ def carry_known(a):
     a.known_f = f
 
 
-def reference(a, ve, vn, sigma, ref_tick):
-    """FIT_VEL: take a reference velocity (E, N) [m/s] with its sigma [m/s],
+def reference(a, ve, vn, vu, sigma, ref_tick):
+    """FIT_VEL: take a reference velocity (E, N, U; U 0 where not measured) [m/s] with its sigma [m/s],
     valid at alignment tick ref_tick (a.tick or earlier; one not newer than
     the last is ignored): completes the grid points it covers (mirrors reference)."""
     if ref_tick < 0 or ref_tick > a.tick or (a.ref_tick >= 0 and ref_tick <= a.ref_tick):
         return   # before the alignment, ahead of it, or not newer than the last: not taken
     dt = a.prm.dt
     sl, cl, sd, cd = ship_sincos(a)
-    cv = ref_vel_i(float(ref_tick) * dt, sl, cl, sd, cd, ve, vn)
+    cv = ref_vel_i(float(ref_tick) * dt, sl, cl, sd, cd, ve, vn, vu)
     # the previous epoch: the last reference, or t0 with this velocity
     first = a.ref_tick < 0
+    if first:
+        # the points before it are left out of the fit
+        a.grid_from = (ref_tick + a.grid_every - 1) // a.grid_every
     t_prev = 0 if first else a.ref_tick
     cv_prev = cv if first else a.ref_cv
     gap = ref_tick - t_prev
@@ -437,6 +441,10 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None, ref_lever_p=None):
     fit = a.prm.method == METHOD_FIT or fit_vel
     if fit_vel:
         carry_known(a)
+        if a.tick == 1:
+            # t0's ib0 side: v^ib0(t0) = 0 less the accelerometers' lever
+            # velocity plus the antenna's (mirrors update)
+            a.grid[0] = ref_lever_p - lever_vel_p if a.prm.lever != 0 else np.array(ref_lever_p, dtype=float)
     if fit and not fit_vel:
         a.pos_ib0 = a.pos_ib0 + (0.5 * a.prm.dt) * (a.vel_prev + vel)
         a.vel_prev = vel.copy()
@@ -451,6 +459,7 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None, ref_lever_p=None):
         if fit_vel:
             a.grid_i = a.grid_i[0:cap:2]
             a.ref_done = (a.ref_done + 1) // 2   # point k was 2k: complete if 2k < ref_done
+            a.grid_from = (a.grid_from + 1) // 2  # and in the fit if 2k >= grid_from
         a.grid_every = 2 * a.grid_every
     if a.tick % a.grid_every == 0 and len(a.grid) < cap:
         if fit_vel:
@@ -462,9 +471,10 @@ def update(a, dtheta_p, dv_p, lever_vel_p=None, ref_lever_p=None):
     if a.tick >= a.prm.first_output and (a.tick - a.prm.first_output) % every == 0:
         if fit_vel:
             # the grid points a reference has completed (a reference interval behind)
-            if a.ref_done > FIT_MIN_INTERVALS:
-                a.mat_i_ib0 = solve_vel_grid(a.grid, a.grid_i, a.ref_done)
-                a.sigma_heading = heading_sigma(a.ref_done, float(a.grid_every) * a.prm.dt,
+            n_fit = a.ref_done - a.grid_from
+            if n_fit > FIT_MIN_INTERVALS:
+                a.mat_i_ib0 = solve_vel_grid(a.grid[a.grid_from:], a.grid_i[a.grid_from:], n_fit)
+                a.sigma_heading = heading_sigma(n_fit, float(a.grid_every) * a.prm.dt,
                                                 a.ref_var / float(a.ref_count), a.prm.gravity,
                                                 a.prm.cos_lat)
                 a.solved = True

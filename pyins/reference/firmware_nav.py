@@ -337,7 +337,10 @@ class NavAtSea:
             # counted from the alignment's start (self.tick - coarse.tick)
             if kind == abi.PYINS_REF_GNSS_VEL:
                 sig = sigma[0] if sigma[0] > sigma[1] else sigma[1]
-                coarse_align.reference(self.coarse, value[0], value[1], sig, tick - (self.tick - self.coarse.tick))
+                # the vertical where the receiver measured one (sigma[2] > 0, finite)
+                vu = value[2] if sigma[2] > 0.0 and math.isfinite(sigma[2]) else 0.0
+                coarse_align.reference(self.coarse, value[0], value[1], vu, sig,
+                                       tick - (self.tick - self.coarse.tick))
             return
         if (self.mode not in (abi.PYINS_MODE_COARSE_ALIGN, abi.PYINS_MODE_FINE_ALIGN)
                 or kind not in (abi.PYINS_REF_GNSS_VEL, abi.PYINS_REF_DVL)):

@@ -59,20 +59,21 @@ def test_mat_n_e_at(lat, dlon):
 
 @settings(max_examples=100, deadline=None)
 @given(t=st.floats(0.0, 3000.0), lat=st.floats(-80.0, 80.0), dlon=st.floats(-0.05, 0.05),
-       ve=st.floats(-30.0, 30.0), vn=st.floats(-30.0, 30.0))
-def test_known_force_i_and_ref_vel_i(t, lat, dlon, ve, vn):
+       ve=st.floats(-30.0, 30.0), vn=st.floats(-30.0, 30.0), vu=st.floats(-3.0, 3.0))
+def test_known_force_i_and_ref_vel_i(t, lat, dlon, ve, vn, vu):
     sl, cl, sd, cd = _sincos_at(lat, dlon)
     g = earth.normal_gravity(sl, 0.0)
     out = ffi.new("double[3]")
     lib.pyins_t_coarse_known_force_i(t, sl, cl, sd, cd, g, ve, vn, out)
     want = coarse_align.known_force_i(t, sl, cl, sd, cd, g, ve, vn)
     assert np.abs(np.array(list(out)) - want).max() <= 4 * ULP * np.abs(want).max()
-    lib.pyins_t_coarse_ref_vel_i(t, sl, cl, sd, cd, ve, vn, out)
-    want_v = coarse_align.ref_vel_i(t, sl, cl, sd, cd, ve, vn)
+    lib.pyins_t_coarse_ref_vel_i(t, sl, cl, sd, cd, ve, vn, vu, out)
+    want_v = coarse_align.ref_vel_i(t, sl, cl, sd, cd, ve, vn, vu)
     assert np.abs(np.array(list(out)) - want_v).max() <= 4 * ULP * max(np.abs(want_v).max(), 1e-300)
     # what they are: C_n^i v keeps |v|; at rest the force is g up^i, whose
     # along-axis part is g sin L
-    assert abs(np.linalg.norm(want_v) - np.hypot(ve, vn)) <= 1e-14 * max(np.hypot(ve, vn), 1.0)
+    speed = np.sqrt(ve * ve + vn * vn + vu * vu)
+    assert abs(np.linalg.norm(want_v) - speed) <= 1e-14 * max(speed, 1.0)
     rest = coarse_align.known_force_i(t, sl, cl, sd, cd, g, 0.0, 0.0)
     assert abs(np.linalg.norm(rest) - g) < 1e-14 * g and abs(rest[2] - g * sl) < 1e-14 * g
 
@@ -154,7 +155,10 @@ def test_under_way_the_mirror_aligns_alike():
     coarse = a["mode"] == abi.PYINS_MODE_COARSE_ALIGN
     assert coarse.sum() >= 100 and (a["mode"][-1] == abi.PYINS_MODE_NAVIGATE)
     assert (a["fault_flags"] == 0).all()
-    assert_engines_agree(a, b)
+    # the NIS to 1e-9 absolute (engines.py's bound for NIS of innovations far below
+    # their sigma, as test_indexed_alignment's 1e-6): 4.9e-11 measured on a NIS of
+    # 0.018 at 614 s, 2.7e-9 of it; the gate decisions are compared exactly
+    assert_engines_agree(a, b, nis_abs=1e-9)
     # the coarse phase alone, tighter than the run's bound (nothing but ulps yet)
     assert np.abs(a["quat_np"][coarse] - b["quat_np"][coarse]).max() < 1e-12
     np.testing.assert_array_equal(a["coarse_wander_rad"] > 0, b["coarse_wander_rad"] > 0)
