@@ -135,7 +135,7 @@ def _early(cfg):
     r = limits.resolved(cfg)
     hz = r["tick_hz"]
     first, every = r["coarse_first_output_ticks"] / hz, r["coarse_output_every_ticks"] / hz
-    if r["coarse_method"] == abi.PYINS_COARSE_FIT:
+    if r["coarse_method"] in (abi.PYINS_COARSE_FIT, abi.PYINS_COARSE_FIT_VEL):
         return limits.explain(abi.PYINS_E_CONFIG_ALIGN_EARLY, cfg, NAMES)
     return (f"--coarse-every: an output interval of {every:g} s is too long: the first coarse "
             f"solution comes at {first:g} s and needs at least one interval of history before it "

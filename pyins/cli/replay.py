@@ -401,6 +401,7 @@ def _feed(args, cfg, hz):
     if not given:
         _dvl_mounting(args, cfg, mounting, None)     # refused: there is nothing they apply to
         _gnss_lever(args, cfg, None)
+        _underway_refs(cfg, hz, None)
         return None
     if cfg.get("nav_mode") == abi.PYINS_NAV_UNDAMPED:
         raise InputError(f"{'/'.join(given)}: the scenario sets firmware.nav_mode = \"undamped\", "
@@ -439,12 +440,29 @@ def _feed(args, cfg, hz):
                              "another nav_mode")
     _dvl_mounting(args, cfg, mounting, refs)
     _gnss_lever(args, cfg, refs)
+    _underway_refs(cfg, hz, refs)
     if args.zero_velocity is not None:
         zv = replay_options.quantity("--zero-velocity", args.zero_velocity, "velocity")
         if not (np.isfinite(zv) and zv > 0.0):
             raise InputError(f"--zero-velocity {args.zero_velocity!r}: a sigma must be more than 0 m/s")
     zv_from = cfg.get("coarse_ticks", 0) + cfg.get("fine_ticks", 0)
     return aiding.BlockFeed(refs, zv, zv_from, hz, sources=sources, notes=notes)
+
+
+def _underway_refs(cfg, hz, refs):
+    """A coarse alignment under way (fit_vel) refused before the log runs
+    when no GNSS velocity reaches its first seconds: the firmware would
+    only fault it at its end (the longest gap it takes: kCoarseRefGapS)."""
+    if cfg.get("coarse_method") != abi.PYINS_COARSE_FIT_VEL or cfg.get("coarse_ticks", 0) <= 0:
+        return
+    gap = fw_config.COARSE_REF_GAP_S * hz
+    vel = np.zeros(0, dtype=np.int64) if refs is None else \
+        refs["tick"][refs["kind"] == contract.REF_KINDS["gnss_vel"]]
+    if not np.any(vel <= gap):
+        first = f"the first is at {vel.min() / hz:g} s" if vel.size else "none is given"
+        raise InputError(f"--coarse-method fit_vel: the alignment under way takes the ship's motion from GNSS "
+                         f"velocities from its first {fw_config.COARSE_REF_GAP_S} s on ({first}): give --gnss "
+                         "(RMC or VTG) or --refs with gnss_vel rows")
 
 
 def _gnss_lever(args, cfg, refs):
