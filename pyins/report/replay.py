@@ -311,6 +311,10 @@ def render(out_dir):
     if al:
         rows.append(_row("aligned attitude", f"at {al['time_s']:g} s: pitch {al['pitch_deg']:.4f} deg, "
                                              f"roll {al['roll_deg']:.4f} deg, heading {al['heading_deg']:.4f} deg"))
+        if al.get("method"):
+            sig = al.get("heading_sigma_arcmin")
+            rows.append(_row("alignment", al["method"] + (f"; heading sigma {sig:.2f} arcmin as navigation began"
+                                                          if sig is not None else "; heading sigma: none estimated")))
     fa = summary.get("fine_alignment")
     if fa:
         lvl = ", ".join(f"{s:.2f}" for s in fa["sigma_level_arcsec"])

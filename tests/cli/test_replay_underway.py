@@ -47,6 +47,25 @@ def test_the_real_log_aligns_under_way_as_fit_does_within_its_sigma(tmp_path):
     assert not (b["state_flags"][-1] & 1)
     assert any(NAV_NOT_YET in w for w in s["warnings"])
     assert int(np.bitwise_or.reduce(b["fault_flags"])) == 0
+    # which alignment ran and how sure it was, in the summary and on the page
+    al = s["aligned"]
+    assert al["method"] == "coarse FIT_VEL (under way) 120 s, then the navigation filter while a reference aids it"
+    k_nav = int(np.searchsorted(b["tick"], 12_000))          # the first navigation record, 120 s
+    assert al["heading_sigma_arcmin"] == pytest.approx(np.degrees(b["nav_sigma_heading_rad"][k_nav]) * 60.0,
+                                                       rel=1e-9)
+    page = (tmp_path / "fit_vel" / "report.html").read_text()
+    assert "coarse FIT_VEL (under way) 120 s" in page and "heading sigma" in page
+
+
+def test_a_replay_with_references_is_rerun_into_its_own_output(tmp_path):
+    # its references.png is its own: the second run replaces the first (it was refused as
+    # "files that are not a replay's")
+    refs = parked_site.fixes(np.arange(0, 30_001, 100), 3.0)
+    R.save_refs_csv(str(tmp_path / "gnss.csv"), refs)
+    for _ in range(2):
+        rc, out = _replay(tmp_path, "again", "--refs", str(tmp_path / "gnss.csv"), "--coarse-method", "fit")
+        assert rc == 0
+    assert (out / "references.png").exists()
 
 
 @pytest.mark.parametrize("first_s", [None, 10])
