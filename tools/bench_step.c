@@ -2,7 +2,7 @@
  *   valgrind --tool=callgrind --toggle-collect=pyins_step ./bench_step 10000 [MODE [API]]
  * counts the instructions inside one API function only (repeatable, unlike
  * time). MODE: nav (default), navix, coarse, fine5, fine8, fit, fine12, navund,
- * navgnss, navlog: every
+ * navgnss, navlog, fitvel: every
  * step in that mode (csrc/embedded/bench_modes.h: the same scenarios as the
  * Cortex-M bench image). API, how the caller takes the records (toggle
  * callgrind on the function named):

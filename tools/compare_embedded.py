@@ -14,7 +14,10 @@ run replays the scenario's integer-only sample and reference generators and
 its fault schedule (csrc/embedded/demo_scenario.c) through the installed
 package: the navigation runs UNDAMPED, INTEGRATED with GNSS (one outlier
 rejected, fixes pushed 0.2 s late), DAMPED by the speed log alone, and
-UNDAMPED again after the encoder glitch turns the bow. Any difference is a failure naming the first differing
+UNDAMPED again after the encoder glitch turns the bow; then demo B ("b"
+lines, a fresh instance): the alignment under way (FIT_VEL, GNSS velocity
+from the first second) and the GNSS-aided alignment in navigation with the
+table indexed that follows it. Any difference is a failure naming the first differing
 tick and field; exit status 1.
 """
 import argparse
@@ -75,9 +78,38 @@ def demo_refs(unit, k):
     return refs
 
 
+def demo_refs_b(unit, k):
+    """Demo B's references (demo_scenario.c, demo_refs_b) before sample k."""
+    t = k + 1
+    refs = []
+    if t % 100 == 0:
+        ve = unit() * K_REF_VEL
+        vn = unit() * K_REF_VEL
+        vu = unit() * K_REF_VEL
+        refs.append((2, t, (ve, vn, vu), (0.0625, 0.0625, 0.0625)))
+    if t % 100 == 20 and t > 100:
+        tf = t - 20
+        dlat = unit() * K_POS
+        dlon = unit() * K_POS
+        refs.append((1, tf, (0.5977054556379782 + dlat, 1.9008380883470242 + dlon, 0.0), (3.0, 3.0, 5.0)))
+    return refs
+
+
 def python_lines():
-    """The demo of csrc/embedded/demo_main.c through pyins.native."""
+    """The demos of csrc/embedded/demo_main.c through pyins.native."""
+    lib = native.lib
+    lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
+    lines += demo_lines(False, 24000)
+    lines.append("demo B: alignment under way (FIT_VEL) and in navigation")
+    lines += demo_lines(True, 12000)
+    lines.append("DONE")
+    return lines
+
+
+def demo_lines(b, ticks):
+    """One demo's lines (demo_main.c's run_demo): b selects demo B."""
     ffi, lib = native.ffi, native.lib
+    tag = "b" if b else ""
     cfg = dict(lat_rad=0.5977054556379782, lon_rad=1.9008380883470242, coarse_ticks=6000, fine_ticks=6000,
                fine_states=12, index_scheme=2, index_stop_ticks=2000, seq_mode=1,
                coarse_method=1, lever_b_m=[0.5, 1.5, 1.25], lever_p_m=[0.0625, 0.0, 0.0],
@@ -86,8 +118,10 @@ def python_lines():
                nav_gyro_bias_rw=5.820766091346741e-11, nav_table_scale_sigma=1.52587890625e-05,
                nav_table_mis_sigma=6.103515625e-05, nav_level_scale_sigma=1.52587890625e-05,
                nav_level_mis_sigma=6.103515625e-05)
+    if b:   # demo_config_b
+        cfg.update(coarse_method=3, fine_ticks=0, fine_states=0, fine_site_accel=0.0)
     fw = native.Firmware(cfg)
-    lines = [f"pyins demo, ABI {lib.pyins_abi_version():x}, instance {lib.pyins_core_size()} bytes"]
+    lines = []
     states = {"samples": 1, "refs": 12345}
     mask = (1 << 64) - 1
     k_ang = 1.0 / 1099511627776.0 / 1048576.0
@@ -104,15 +138,15 @@ def python_lines():
     sample = ffi.new("pyins_sample *")
     out = ffi.new("pyins_output *")
     ref = ffi.new("pyins_ref *")
-    for k in range(24000):
-        fault = demo_fault(k)
-        for kind, tick, value, sigma in demo_refs(lambda: draw("refs"), k):
+    for k in range(ticks):
+        fault = DEMO_NONE if b else demo_fault(k)
+        for kind, tick, value, sigma in (demo_refs_b if b else demo_refs)(lambda: draw("refs"), k):
             ref.kind, ref.reserved, ref.tick = kind, 0, tick
             ref.value[0:3] = list(value)
             ref.sigma[0:3] = list(sigma)
             st = lib.pyins_push_ref(fw.core, ref)
             if st != 0:
-                lines.append(f"R {k} {kind} {st}")
+                lines.append(f"{tag}R {k} {kind} {st}")
         step = cmd - cmd_prev
         step = 0.0 if step > 0.1 or step < -0.1 else step   # a reset's jump is not a motion
         side = -1.0 if 1.5707963267948966 < enc < 4.71238898038469 else 1.0
@@ -135,7 +169,7 @@ def python_lines():
         for _ in range(steps):
             st = lib.pyins_step(fw.core, sample, out)
             if st != 0:
-                lines.append(f"S {k} {st}")
+                lines.append(f"{tag}S {k} {st}")
             if st < 0 and not ((fault == DEMO_NAN and st == lib.PYINS_E_SAMPLE_NONFINITE)
                                or (fault == DEMO_SATURATE and st == lib.PYINS_E_SAMPLE_SATURATED)):
                 raise RuntimeError(f"step {k}: {native.status_str(st)}")
@@ -161,9 +195,8 @@ def python_lines():
                                             out.n_ref_rejected[0], out.n_ref_used[1], out.n_ref_rejected[1],
                                             out.n_ref_used[2], out.n_ref_rejected[2], out.n_ref_used[3],
                                             out.n_ref_rejected[3]))
-            lines.append(f"{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {nav} "
+            lines.append(f"{tag}{k + 1} {out.mode} {out.index_state} {out.fault_flags:x} {out.tick} {counts} {nav} "
                          f"{hexes}")
-    lines.append("DONE")
     return lines
 
 

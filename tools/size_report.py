@@ -19,7 +19,7 @@ own frame and an exception frame).
 Cost per tick, in each mode of csrc/embedded/bench_modes.h (nav, navix =
 navigation with the two-position scheme, coarse, fine5, fine8, fit = the
 moving-base coarse alignment with a lever arm, fine12 = the moving-base fine
-filter; 3000 ticks):
+filter, fitvel = the coarse alignment under way; 3000 ticks):
   - host: instructions inside pyins_step from callgrind (build/host/bench_step);
   - Cortex-M7 and M4F: instructions per pyins_step, mean and worst tick,
     measured under QEMU with -icount (csrc/embedded/bench_main.c: SysTick
@@ -48,8 +48,8 @@ import stack_depth  # noqa: E402
 from pyins import native  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "navund", "navgnss", "navlog", "nav_null",
-         "nav_compact")
+MODES = ("nav", "navix", "coarse", "fine5", "fine8", "fit", "fine12", "navund", "navgnss", "navlog", "fitvel",
+         "nav_null", "nav_compact")
 #: the rows that are the "nav" scenario through another API (bench_step's API argument and
 #: the function callgrind counts): no record, a compact record every tick
 API_OF = {"nav_null": ("nav", "null", "pyins_run"), "nav_compact": ("nav", "compact", "pyins_run_nav")}

@@ -19,6 +19,8 @@
  *           the count wants the updates)
  *   navlog  NAVIGATE, the EM speed log alone at 5 Hz: the current learnt
  *           from its first 60 readings (12 s), DAMPED after 10 s of course
+ *   fitvel  COARSE_ALIGN under way (FIT_VEL): GNSS velocity at 1 Hz taken
+ *           into the inertial side as it comes, a 2 m lever arm
  * The IMU swings gently, so every branch of a moving step runs. The
  * references (bench_refs) are pushed before the step, outside the count
  * (pyins_push_ref only queues them). */
@@ -30,10 +32,11 @@
 #include "pyins_core.h"
 
 enum { BENCH_NAV, BENCH_NAVIX, BENCH_COARSE, BENCH_FINE5, BENCH_FINE8, BENCH_FIT, BENCH_FINE12,
-       BENCH_NAVUND, BENCH_NAVGNSS, BENCH_NAVLOG, BENCH_N_MODES };
+       BENCH_NAVUND, BENCH_NAVGNSS, BENCH_NAVLOG, BENCH_FITVEL, BENCH_N_MODES };
 
 static const char *const bench_mode_name[BENCH_N_MODES] = {"nav", "navix", "coarse", "fine5", "fine8",
-                                                           "fit", "fine12", "navund", "navgnss", "navlog"};
+                                                           "fit", "fine12", "navund", "navgnss", "navlog",
+                                                           "fitvel"};
 
 /* The mode called name, or -1. */
 static int bench_mode_of(const char *name) {
@@ -89,6 +92,14 @@ static int bench_config(int m, long n, pyins_config *cfg) {
             return 0;
         case BENCH_NAVLOG:
             return 0;
+        case BENCH_FITVEL:
+            cfg->coarse_ticks = (int32_t)n + 1;
+            cfg->coarse_method = PYINS_COARSE_FIT_VEL;
+            cfg->fine_ticks = 0;
+            cfg->lever_b_m[0] = 0.5;
+            cfg->lever_b_m[1] = 1.5;
+            cfg->lever_b_m[2] = 1.2;
+            return 0;
         default:
             return -1;
     }
@@ -102,7 +113,13 @@ static int bench_refs(int m, long i, pyins_ref *refs) {
     const double wiggle = (double)(t % 700) * 1e-3;
     int n = 0;
     memset(refs, 0, 2 * sizeof *refs);
-    if (m == BENCH_NAVGNSS && t % 100 == 0) {
+    if (m == BENCH_FITVEL && t % 100 == 0) {
+        refs[n].kind = PYINS_REF_GNSS_VEL;
+        refs[n].tick = t;
+        refs[n].value[0] = wiggle;
+        refs[n].sigma[0] = refs[n].sigma[1] = refs[n].sigma[2] = 0.05;
+        ++n;
+    } else if (m == BENCH_NAVGNSS && t % 100 == 0) {
         refs[n].kind = PYINS_REF_GNSS_POS;
         refs[n].tick = t;
         refs[n].value[0] = 0.6 + wiggle * 1e-7;

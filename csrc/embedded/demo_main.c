@@ -1,4 +1,5 @@
-/* demo_main.c: run the demo scenario through the firmware and print, every
+/* demo_main.c: run the demo scenarios (A, then B on a fresh instance:
+ * demo_scenario.h) through the firmware and print, every
  * DEMO_PRINT_EVERY samples, the output record's mode, index state, fault
  * bits, tick, sample-level counters, the navigation mode and reference
  * counters, and key doubles as hex, one "S" line per sample whose status is
@@ -22,7 +23,11 @@ static void put_hex(double x) {
     printf(" %08lx%08lx", (unsigned long)(u >> 32), (unsigned long)(u & 0xffffffffu));
 }
 
-int main(void) {
+/* Run one demo on a fresh instance: b = 0 demo A (demo_config, demo_fault,
+ * demo_refs), b = 1 demo B (demo_config_b, no faults, demo_refs_b); its
+ * lines carry the sample number, demo B's prefixed "b". 0 or the failing
+ * exit code. */
+static int run_demo(int b, uint32_t ticks) {
     pyins_config cfg;
     pyins_sample s;
     pyins_output out;
@@ -30,22 +35,21 @@ int main(void) {
     uint64_t lcg_refs = 12345u;
     double enc = 0.0;
     double cmd = 0.0, cmd_prev = 0.0;   /* the unwrapped commanded angle, now and a tick ago */
+    const char *tag = b ? "b" : "";
     uint32_t k;
     int st;
-    if (pyins_core_size() > sizeof g_mem) {
-        printf("FAIL instance %lu bytes > %lu\n", (unsigned long)pyins_core_size(), (unsigned long)sizeof g_mem);
-        return 2;
+    if (b) {
+        demo_config_b(&cfg);
+    } else {
+        demo_config(&cfg);
     }
-    demo_config(&cfg);
     st = pyins_init(g_mem, sizeof g_mem, &cfg);
     if (st != PYINS_OK) {
         printf("FAIL init %d %s\n", st, pyins_status_str(st));
         return 3;
     }
-    printf("pyins demo, ABI %lx, instance %lu bytes\n", (unsigned long)pyins_abi_version(),
-           (unsigned long)pyins_core_size());
-    for (k = 0; k < DEMO_TICKS; ++k) {
-        const int fault = demo_fault(k);
+    for (k = 0; k < ticks; ++k) {
+        const int fault = b ? DEMO_NONE : demo_fault(k);
         /* a dropped sample is lost on the way: the core sees the seq gap on the next one */
         const int steps = fault == DEMO_DROP ? 0 : (fault == DEMO_REPEAT ? 2 : 1);
         int rep;
@@ -53,28 +57,28 @@ int main(void) {
             /* the IMU turns with the table; a reset's jump of the command (the
                glitched reading it restarts from) is not a motion */
             const double step = cmd - cmd_prev;
-            demo_sample(&lcg, k, enc, step > 0.1 || step < -0.1 ? 0.0 : step, &s);
+            demo_sample(&lcg, k, fault, enc, step > 0.1 || step < -0.1 ? 0.0 : step, &s);
         }
         {
             pyins_ref refs[DEMO_MAX_REFS];
-            const int n_refs = demo_refs(&lcg_refs, k, refs);
+            const int n_refs = b ? demo_refs_b(&lcg_refs, k, refs) : demo_refs(&lcg_refs, k, refs);
             int r;
             for (r = 0; r < n_refs; ++r) {
                 st = pyins_push_ref((pyins_core *)g_mem, &refs[r]);
                 if (st != PYINS_OK) {
-                    printf("R %lu %ld %d\n", (unsigned long)k, (long)refs[r].kind, st);
+                    printf("%sR %lu %ld %d\n", tag, (unsigned long)k, (long)refs[r].kind, st);
                 }
             }
         }
         for (rep = 0; rep < steps; ++rep) {
             st = pyins_step((pyins_core *)g_mem, &s, &out);
             if (st != PYINS_OK) {
-                printf("S %lu %d\n", (unsigned long)k, st);
+                printf("%sS %lu %d\n", tag, (unsigned long)k, st);
             }
             /* only the scheduled rejections are expected */
             if (st < 0 && !(fault == DEMO_NAN && st == PYINS_E_SAMPLE_NONFINITE) &&
                 !(fault == DEMO_SATURATE && st == PYINS_E_SAMPLE_SATURATED)) {
-                printf("FAIL step %lu %d %s\n", (unsigned long)k, st, pyins_status_str(st));
+                printf("FAIL step %s%lu %d %s\n", tag, (unsigned long)k, st, pyins_status_str(st));
                 return 4;
             }
         }
@@ -89,7 +93,7 @@ int main(void) {
         while (enc >= 6.283185307179586) enc -= 6.283185307179586;
         while (enc < 0.0) enc += 6.283185307179586;
         if ((k + 1u) % DEMO_PRINT_EVERY == 0u) {
-            printf("%lu %ld %ld %lx %ld %lu/%lu/%lu/%lu/%lu/%lu/%lu", (unsigned long)(k + 1u), (long)out.mode,
+            printf("%s%lu %ld %ld %lx %ld %lu/%lu/%lu/%lu/%lu/%lu/%lu", tag, (unsigned long)(k + 1u), (long)out.mode,
                    (long)out.index_state, (unsigned long)out.fault_flags, (long)out.tick,
                    (unsigned long)out.n_nonfinite, (unsigned long)out.n_saturated,
                    (unsigned long)out.n_seq_gaps, (unsigned long)out.n_seq_bridged,
@@ -117,6 +121,26 @@ int main(void) {
             put_hex(out.nav_nis[0]);
             printf("\n");
         }
+    }
+    return 0;
+}
+
+int main(void) {
+    int rc;
+    if (pyins_core_size() > sizeof g_mem) {
+        printf("FAIL instance %lu bytes > %lu\n", (unsigned long)pyins_core_size(), (unsigned long)sizeof g_mem);
+        return 2;
+    }
+    printf("pyins demo, ABI %lx, instance %lu bytes\n", (unsigned long)pyins_abi_version(),
+           (unsigned long)pyins_core_size());
+    rc = run_demo(0, DEMO_TICKS);
+    if (rc != 0) {
+        return rc;
+    }
+    printf("demo B: alignment under way (FIT_VEL) and in navigation\n");
+    rc = run_demo(1, DEMO_B_TICKS);
+    if (rc != 0) {
+        return rc;
     }
     printf("DONE\n");
     return 0;

@@ -58,6 +58,14 @@ void demo_config(pyins_config *cfg) {
     cfg->nav_level_mis_sigma = 6.103515625e-05;
 }
 
+void demo_config_b(pyins_config *cfg) {
+    demo_config(cfg);
+    cfg->coarse_method = PYINS_COARSE_FIT_VEL;   /* under way: the GNSS velocity takes out the motion */
+    cfg->fine_ticks = 0;                          /* FIT_VEL's rule: the navigation filter aligns on */
+    cfg->fine_states = 0;
+    cfg->fine_site_accel = 0.0;
+}
+
 int demo_fault(uint32_t k) {
     if (k == 3000u) return DEMO_REPEAT;                    /* coarse alignment: dropped, no restart */
     if (k == 14000u) return DEMO_DROP;                     /* navigation: 1 tick bridged */
@@ -76,8 +84,8 @@ static double lcg_unit(uint64_t *state) {
     return (double)((int64_t)(*state >> 43) - (int64_t)(1 << 20));
 }
 
-void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, double table_step_rad, pyins_sample *s) {
-    const int fault = demo_fault(k);
+void demo_sample(uint64_t *state, uint32_t k, int fault, double encoder_rad, double table_step_rad,
+                 pyins_sample *s) {
     const double k_ang = 1.0 / 1099511627776.0 / 1048576.0;  /* 2^-60 rad per LCG unit */
     const double k_vel = 1.0 / 1073741824.0 / 1048576.0;     /* 2^-50 m/s per LCG unit */
     /* the IMU turns with the table: its z increment gains the table's step,
@@ -162,6 +170,27 @@ int demo_refs(uint64_t *lcg, uint32_t k, pyins_ref *refs) {
         const double vy = lcg_unit(lcg) * k_vel;
         const double vz = lcg_unit(lcg) * k_vel;
         demo_ref(&refs[n++], PYINS_REF_DVL, (int64_t)t, vx, vy, vz, 0.0625, 0.0625, 0.0625);
+    }
+    return n;
+}
+
+int demo_refs_b(uint64_t *lcg, uint32_t k, pyins_ref *refs) {
+    const double k_pos = 1.0 / 1099511627776.0;     /* 2^-40 rad per unit: up to 6 m */
+    const double k_vel = 1.0 / 16777216.0;          /* 2^-24 m/s per unit: up to 0.0625 m/s */
+    const uint32_t t = k + 1u;
+    int n = 0;
+    if (t % 100u == 0u) {
+        const double ve = lcg_unit(lcg) * k_vel;
+        const double vn = lcg_unit(lcg) * k_vel;
+        const double vu = lcg_unit(lcg) * k_vel;
+        demo_ref(&refs[n++], PYINS_REF_GNSS_VEL, (int64_t)t, ve, vn, vu, 0.0625, 0.0625, 0.0625);
+    }
+    if (t % 100u == 20u && t > 100u) {
+        const uint32_t tf = t - 20u;
+        const double dlat = lcg_unit(lcg) * k_pos;
+        const double dlon = lcg_unit(lcg) * k_pos;
+        demo_ref(&refs[n++], PYINS_REF_GNSS_POS, (int64_t)tf, 0.5977054556379782 + dlat,
+                 1.9008380883470242 + dlon, 0.0, 3.0, 3.0, 5.0);
     }
     return n;
 }

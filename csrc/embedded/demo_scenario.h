@@ -27,6 +27,13 @@
 
 #define DEMO_TICKS 24000u
 #define DEMO_PRINT_EVERY 500u
+/* Demo B (after demo A, on a fresh instance): the alignment under way
+ * (PYINS_COARSE_FIT_VEL, 60 s, GNSS velocity from the first second) and the
+ * alignment in navigation that follows it (no fine phase: the navigation
+ * filter starts on the coarse attitude, GNSS-aided, the table indexed), on
+ * the same moored ship (0 kn: the velocity references are the receiver's
+ * noise about zero, the heave in the vertical); no sample faults. */
+#define DEMO_B_TICKS 12000u
 
 /* What happens to sample k (demo_fault). */
 enum demo_fault_kind {
@@ -43,18 +50,27 @@ extern "C" {
 #endif
 
 void demo_config(pyins_config *cfg);
+/* Demo B's configuration: demo A's with the coarse method FIT_VEL, no fine
+ * phase. */
+void demo_config_b(pyins_config *cfg);
 /* The fault schedule: enum demo_fault_kind of sample k (0-based). */
 int demo_fault(uint32_t k);
-/* The sample of tick k (0-based), seq = k + 1, with demo_fault(k)'s content
- * fault applied; state is the LCG state (start at 1); table_step_rad the
- * table's turn over the tick (the IMU turns with it). */
-void demo_sample(uint64_t *state, uint32_t k, double encoder_rad, double table_step_rad, pyins_sample *s);
+/* The sample of tick k (0-based), seq = k + 1, with the content fault
+ * `fault` (enum demo_fault_kind: demo_fault(k) in demo A, DEMO_NONE in B)
+ * applied; state is the LCG state (start at 1); table_step_rad the table's
+ * turn over the tick (the IMU turns with it). */
+void demo_sample(uint64_t *state, uint32_t k, int fault, double encoder_rad, double table_step_rad,
+                 pyins_sample *s);
 
 /* The references to push before stepping sample k (0-based): writes up to
  * DEMO_MAX_REFS into refs and returns how many; state is their noise's LCG
  * (start at 12345, apart from the samples'). */
 #define DEMO_MAX_REFS 2
 int demo_refs(uint64_t *state, uint32_t k, pyins_ref *refs);
+/* Demo B's references before sample k: GNSS velocity (3-axis sigma: the
+ * vertical used) every second from the first, and the fix of each second
+ * pushed 0.2 s late (as demo A's), from the first second on. */
+int demo_refs_b(uint64_t *state, uint32_t k, pyins_ref *refs);
 
 #ifdef __cplusplus
 }
