@@ -25,6 +25,7 @@ headings of the median over the seeds, and how often the integrity bits
 fired. Writes moored.json and moored.md into --out (~1 min per seed).
 """
 import argparse
+import dataclasses
 import json
 import os
 import sys
@@ -118,12 +119,98 @@ def run_case(spec, exact):
     return native.Firmware(cfg).run(native.make_samples(dtheta[:n], dv[:n]), every=1000)
 
 
+#: FIT's level error split (--fit-level): the sensor errors of each variant, from the case's
+#: (seed 000's: 0.01 deg/h, 100 ug on every axis, ARW, VRW)
+FIT_LEVEL_VARIANTS = {
+    "seed 000's errors": lambda e: e,
+    "horizontal gyro drift zeroed": lambda e: dataclasses.replace(e, gyro_bias=e.gyro_bias * [0.0, 0.0, 1.0]),
+    "horizontal gyro drift only (no noise, no accelerometer bias)": lambda e: sim.SensorErrors(
+        gyro_bias=e.gyro_bias * [1.0, 1.0, 0.0]),
+}
+
+
+def fit_level(n_seeds, out_dir):
+    """FIT's level error against the static limit nabla/g at 200, 300 and 600 s on the moored
+    ship (lever arm configured), every sea state and heading, as the table's 'fit' rows, with
+    seed 000's errors, with the horizontal gyro drift zeroed, and with that drift alone (then
+    also as a share of eps_h T, eps_h = 0.01 deg/h the drift of each horizontal gyro).
+    Writes fit_level.md and fit_level.json."""
+    n = TIMES_S[-1] * TICK_HZ
+    res = {v: {t: [] for t in TIMES_S} for v in FIT_LEVEL_VARIANTS}
+    eps_h = None
+    for state in SEA_STATES:
+        for h, scns in points(state, n_seeds).items():
+            m = spec_of(scns[0], "moored", "configured", "fit").motion
+            exact = sim.exact_increments(m, n)[:2]
+            truth = {t: sim.truth_at(m, np.array([t * TICK_HZ])) for t in TIMES_S}
+            for scn in scns:
+                base = spec_of(scn, "moored", "configured", "fit")
+                eps_h = float(abs(base.errors.gyro_bias[0]))
+                for v, make in FIT_LEVEL_VARIANTS.items():
+                    spec = dataclasses.replace(base, errors=make(base.errors))
+                    rec = run_case(spec, exact)
+                    for t in TIMES_S:
+                        i = np.flatnonzero(rec["tick"] == t * TICK_HZ)[0]
+                        d = wrap(rec["euler_b_rad"][i] - truth[t].euler[0])[:2]
+                        lim = limit_euler(m, spec.errors, float(t))[:2] * ARCSEC
+                        res[v][t].append((state, h, float(np.max(np.abs(d - lim)))))
+    out, md = {}, ["| errors | t (s) | level vs limit (\") | eps_h t (\") | share of eps_h t |",
+                   "|---|---|---|---|---|"]
+    for v in FIT_LEVEL_VARIANTS:
+        for t in TIMES_S:
+            # the table's statistic: the largest over the sea states and headings of the median
+            # over the seeds
+            groups = {}
+            for state, h, x in res[v][t]:
+                groups.setdefault((state, h), []).append(x)
+            worst = max(float(np.median(x)) for x in groups.values()) / ARCSEC
+            drift = eps_h * t / ARCSEC
+            out[f"{v}/{t}s"] = {"level_vs_limit_arcsec": worst, "eps_h_t_arcsec": drift}
+            md.append(f"| {v} | {t} | {worst:.2f} | {drift:.2f} | {worst / drift:.2f} |")
+    # which horizontal drift tilts it: one gyro's drift alone (seed 000's ideal sea, headings 0
+    # and 60 deg, no noise), the pitch and roll errors per eps t and the heading error
+    md += ["", "| heading (deg) | drift alone | t (s) | pitch error / eps t | roll error / eps t | "
+               "heading error (') |", "|---|---|---|---|---|---|"]
+    for h, scns in points(SEA_STATES[0], 1).items():
+        if h not in (0, 60):
+            continue
+        m = spec_of(scns[0], "moored", "configured", "fit").motion
+        exact = sim.exact_increments(m, n)[:2]
+        base = spec_of(scns[0], "moored", "configured", "fit")
+        for axis, mask in (("x gyro", [1.0, 0.0, 0.0]), ("y gyro", [0.0, 1.0, 0.0])):
+            spec = dataclasses.replace(base, errors=sim.SensorErrors(gyro_bias=base.errors.gyro_bias * mask))
+            rec = run_case(spec, exact)
+            for t in TIMES_S:
+                i = np.flatnonzero(rec["tick"] == t * TICK_HZ)[0]
+                d = wrap(rec["euler_b_rad"][i] - sim.truth_at(m, np.array([t * TICK_HZ])).euler[0])
+                et = eps_h * t
+                out[f"h{h}/{axis}/{t}s"] = {"pitch_per_eps_t": float(d[0] / et), "roll_per_eps_t": float(d[1] / et),
+                                            "heading_err_arcmin": float(-d[2] / ARCMIN)}
+                md.append(f"| {h} | {axis} | {t} | {d[0] / et:+.3f} | {d[1] / et:+.3f} | {-d[2] / ARCMIN:+.2f} |")
+    md += ["", f"FIT on the moored ship (lever arm configured), seed 000's three sea states x six "
+               f"headings x {n_seeds} noise seeds; each figure the largest over the sea states and "
+               "headings of the median over the seeds of max(|pitch|, |roll|) error minus the static "
+               "limit (nabla/g), as moored.md's 'level vs limit'. Written by "
+               "tools/papers/moored_alignment.py --fit-level."]
+    with open(os.path.join(out_dir, "fit_level.json"), "w") as f:
+        json.dump({"seeds": n_seeds, "eps_h_dph": eps_h / (np.pi / 180 / 3600), "cases": out}, f, indent=1)
+    with open(os.path.join(out_dir, "fit_level.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    return "\n".join(md)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default="runs/moored")
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--fit-level", action="store_true",
+                    help="only FIT's level error, with the horizontal gyro drift zeroed and alone "
+                         "(fit_level.md)")
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
+    if args.fit_level:
+        print(fit_level(args.seeds, args.out))
+        return 0
     t0 = time.time()
     n = TIMES_S[-1] * TICK_HZ
     rows = []   # dicts, one per (state, heading, case, alignment, seed, time)
