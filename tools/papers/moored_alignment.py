@@ -241,7 +241,7 @@ def main(argv=None):
         print(f"{state}: done ({time.time() - t0:.0f} s)", flush=True)
     summary = {}
     md = ["| sea state | case | alignment | t (s) | heading err (') | heading vs limit (') | "
-          "level vs limit (\") | integrity fired / runs | runs with \|heading err\| > 10' |",
+          "level vs limit (\") | integrity fired / runs | runs with \\|heading err\\| > 10' |",
           "|---|---|---|---|---|---|---|---|---|"]
     missed = 0
     for state in SEA_STATES:
