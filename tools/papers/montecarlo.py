@@ -41,6 +41,15 @@ from pyins import campaign, scenario
 from pyins.units import NMI_TO_M
 
 CAMPAIGNS = {"seed002": "seed002_montecarlo", "seed003": "seed003_montecarlo"}
+#: seed 002's Table 1 heading (15 deg) and heading error (1'), read two ways (docs/papers.md,
+#: seed 002 §7; docs/results/seed002.md, "Table 1's heading: two readings"): "ccw" is PSINS's
+#: yaw, positive north-west (yaw +15 deg, yaw error +1'), the reading the project adopts;
+#: "clockwise" a marine heading (yaw -15 deg, yaw error -1'), the built-in scenarios' and the
+#: reading of this report before 2026-12-06. name -> the campaign's extra fixed overrides.
+CONVENTIONS = {"ccw": {"motion.yaw": "15 deg", "initial_errors.yaw": "60 arcsec"},
+               "clockwise": {}}
+#: the reading the seed 002 campaign runs under (--convention)
+CONVENTION = {"name": "ccw"}
 #: seed 002's experiments: motion.period -> the scenario holding that experiment's [paper]
 SEED002_EXPERIMENTS = {"120 s": ("exp. 1", "seed002_exp1"), "60 s": ("exp. 2", "seed002_exp2")}
 #: the paired comparisons: (seed, better, worse) schemes
@@ -58,6 +67,21 @@ METRICS = {"seed002": [("horizontal_error_final", "nmi", NMI_TO_M), ("horizontal
 # ---------------------------------------------------------------------------
 # 1. The campaigns, in blocks of draws
 # ---------------------------------------------------------------------------
+def load(key):
+    """The campaign of ``key``; seed 002's with Table 1's heading read as CONVENTION says
+    (its fixed overrides added to the built-in's [campaign.set])."""
+    extra = CONVENTIONS[CONVENTION["name"]] if key == "seed002" else {}
+    if not extra:
+        return campaign.load_campaign(CAMPAIGNS[key])
+    from pyins.campaign import spec as cspec
+    path = cspec.builtin_path(CAMPAIGNS[key])
+    text = path.read_text(encoding="utf-8")
+    lines = "".join(f'"{k}" = "{v}"\n' for k, v in extra.items())
+    assert text.count("[campaign.set]\n") == 1
+    text = text.replace("[campaign.set]\n", "[campaign.set]\n" + lines)
+    return cspec.loads_campaign(text, source=str(path), name=path.stem, relative_to=path)
+
+
 def first_draws(camp, n, schemes=None):
     """``camp`` restricted to its first ``n`` draws (seeds entries) and to
     ``schemes`` (indexing.scheme values; None: all), the points renumbered.
@@ -95,7 +119,7 @@ def _add_session(out, session):
 
 def run_seed(key, draws, block, out, workers=None, scheduler=None, quiet=False, schemes=None):
     """Run campaign ``key`` (seed002 / seed003) for its first ``draws`` draws in blocks."""
-    camp = campaign.load_campaign(CAMPAIGNS[key])
+    camp = load(key)
     draws = min(draws, len(camp.seeds))
     os.makedirs(out, exist_ok=True)
     t0 = time.perf_counter()
@@ -373,13 +397,130 @@ def collect(camp, out):
             "runs_timing": {"complete": len(run_s), "run_s": float(sum(run_s)), "span_s": span}}
 
 
+# ---------------------------------------------------------------------------
+# 3b. Per draw: the error vectors, the draw nearest the paper, the scheme's own error
+# ---------------------------------------------------------------------------
+#: the paper's three schemes (its figures), in its order
+PAPER_SCHEMES = ("none", "two_position", "flexible")
+
+
+def draw_vectors(camp, out):
+    """{draw: {"scheme|period": [north, east, max horizontal] (nmi)}} at the run's end, read
+    from each complete run's timeseries.npz (the records every 60 s)."""
+    import glob
+    from pyins.campaign.aggregate import read_summary
+    vec = {}
+    for p in camp.points:
+        s = read_summary(os.path.join(out, p.dir))
+        if s is None or s.get("complete") is not True or s.get("digest") != p.digest:
+            continue
+        (f,) = glob.glob(os.path.join(out, p.dir, "*", "timeseries.npz"))
+        z = np.load(f)
+        vec.setdefault(int(p.run), {})[f"{p.values['indexing.scheme']}|{p.values['motion.period']}"] = [
+            float(z["north_m"][-1] / NMI_TO_M), float(z["east_m"][-1] / NMI_TO_M),
+            float(z["horizontal_m"].max() / NMI_TO_M)]
+    return {d: vec[d] for d in sorted(vec)}
+
+
+def up_gyro_response(convention):
+    """The final (north, east) error [nmi] of +0.003 deg/h on the up gyro alone (no other
+    error, no noise, no initial error; no rotation: a vertical-axis table does not change it,
+    docs/results/seed002.md), per experiment period, under ``convention``. Two 72-h runs."""
+    from pyins import metrics, run_scenario
+    out = {}
+    for period, (_, name) in SEED002_EXPERIMENTS.items():
+        sc = scenario.load(name).with_overrides({**CONVENTIONS[convention], "compare": None, "paper": None,
+                                                "indexing.scheme": "none", "initial_errors": None,
+                                                "sensors": {"gyro_bias": [0, 0, "0.003 deg/h"]}})
+        (spec,) = sc.runs()
+        e = metrics.nav_errors(run_scenario.run(spec))
+        out[period] = [float(e.north_m[-1] / NMI_TO_M), float(e.east_m[-1] / NMI_TO_M)]
+    return out
+
+
+def joint(vec, papers, up_response):
+    """What the draws say about the paper's six figures at once and about the schemes
+    beyond the floor they share (docs/results/montecarlo.md, "The paper's six figures at
+    once" and "Beside the shared up-gyro floor")."""
+    keys = [f"{s}|{p}" for p in SEED002_EXPERIMENTS for s in PAPER_SCHEMES]
+    paper = np.array([papers[(s, p)]["horizontal_error_final"]["value_si"] / NMI_TO_M
+                      for p in SEED002_EXPERIMENTS for s in PAPER_SCHEMES])
+    full = [d for d in vec if all(k in vec[d] for k in keys)]
+    fin = np.array([[math.hypot(*vec[d][k][:2]) for k in keys] for d in full])
+    rms = np.sqrt(np.mean((fin - paper) ** 2, axis=1))
+    i = int(np.argmin(rms))
+    res = {"draws": len(full), "paper_final_nmi": paper.tolist(),
+           "nearest": {"draw": int(full[i]), "rms_nmi": float(rms[i]),
+                       "max_abs_nmi": float(np.max(np.abs(fin[i] - paper))), "final_nmi": fin[i].tolist()},
+           "rms_nmi_median": float(np.median(rms))}
+    for tol in (0.25, 0.5):
+        k = int(np.sum(np.all(np.abs(fin - paper) <= tol * paper, axis=1)))
+        res[f"all_six_within_{int(tol * 100)}pct"] = {"count": k, "ci90": list(clopper_pearson(k, len(full)))}
+    orders = {}
+    for j, p in enumerate(SEED002_EXPERIMENTS):
+        no, tr, fl = fin[:, 3 * j], fin[:, 3 * j + 1], fin[:, 3 * j + 2]
+        orders[SEED002_EXPERIMENTS[p][0]] = (no > tr) & (tr > fl)
+    both = orders["exp. 1"] & orders["exp. 2"]
+    res["paper_order"] = {name: {"count": int(o.sum()), "ci90": list(clopper_pearson(int(o.sum()), len(full)))}
+                          for name, o in [*orders.items(), ("both", both)]}
+    # the schemes beyond the up-gyro floor they share: each draw's error vector minus what its
+    # drawn eps_U alone gives (the same for every scheme), and the difference of two schemes'
+    # vectors, from which that floor cancels
+    pairs = []
+    for better, worse in [("flexible", "two_position"), ("two_position", "none"), ("flexible", "none")]:
+        for p in SEED002_EXPERIMENTS:
+            a, b, wins, diff, own_a, own_b = f"{better}|{p}", f"{worse}|{p}", 0, [], [], []
+            ds = [d for d in vec if a in vec[d] and b in vec[d]]
+            for d in ds:
+                u = np.array(up_response[p]) * up_gyro_dph("seed002", d) / 0.003
+                ea, eb = np.array(vec[d][a][:2]), np.array(vec[d][b][:2])
+                own_a.append(np.hypot(*(ea - u)))
+                own_b.append(np.hypot(*(eb - u)))
+                wins += own_a[-1] < own_b[-1]
+                diff.append(np.hypot(*(ea - eb)))
+            pairs.append({"experiment": SEED002_EXPERIMENTS[p][0], "better": better, "worse": worse,
+                          "n": len(ds), "wins_beyond_floor": int(wins),
+                          "p": wins / len(ds), "ci90": list(clopper_pearson(int(wins), len(ds))),
+                          "median_own_better_nmi": float(np.median(own_a)),
+                          "median_own_worse_nmi": float(np.median(own_b)),
+                          "median_abs_difference_nmi": float(np.median(diff))})
+    res["beyond_floor"] = pairs
+    res["up_gyro_response_nmi_per_3e-3_dph"] = up_response
+    return res
+
+
+def _fmt_joint(j, labels):
+    paper = j["paper_final_nmi"]
+    n = j["nearest"]
+    out = [f"Draws with all six Table 2 rows: {j['draws']}. The paper's six final errors (exp. 1 none / "
+           f"traditional / flexible, exp. 2 the same): {' / '.join(f'{x:g}' for x in paper)} nmi.", "",
+           f"- The draw nearest to all six at once (RMS of the six differences): draw {n['draw']}, "
+           f"{' / '.join(f'{x:.2f}' for x in n['final_nmi'])} nmi, RMS {n['rms_nmi']:.2f} nmi, its largest "
+           f"difference {n['max_abs_nmi']:.2f} nmi (the median draw's RMS: {j['rms_nmi_median']:.2f} nmi).",
+           *(f"- All six within {t} % of the paper's figure: {j[f'all_six_within_{t}pct']['count']} of "
+             f"{j['draws']} draws (90 % interval {j[f'all_six_within_{t}pct']['ci90'][0]:.3f}-"
+             f"{j[f'all_six_within_{t}pct']['ci90'][1]:.3f})." for t in (25, 50)),
+           *(f"- The paper's order none > traditional > flexible in {name}: {o['count']} of {j['draws']} "
+             f"draws (90 % interval {o['ci90'][0]:.2f}-{o['ci90'][1]:.2f})."
+             for name, o in j["paper_order"].items()), "",
+           "| experiment | comparison | draws | P(first's own error smaller) | 90 % interval | "
+           "median own error, first / second (nmi) | median abs(difference of the error vectors) (nmi) |",
+           "|---|---|---|---|---|---|---|"]
+    for p in j["beyond_floor"]:
+        out.append(f"| {p['experiment']} | {labels[p['better']]} < {labels[p['worse']]} | {p['n']} | "
+                   f"{p['p']:.2f} ({p['wins_beyond_floor']}/{p['n']}) | {p['ci90'][0]:.2f} - {p['ci90'][1]:.2f} | "
+                   f"{p['median_own_better_nmi']:.2f} / {p['median_own_worse_nmi']:.2f} | "
+                   f"{p['median_abs_difference_nmi']:.2f} |")
+    return out
+
+
 def report(keys, out_root, report_dir):
     """Write montecarlo.json and the histograms into ``report_dir``; returns the tables as Markdown."""
     os.makedirs(report_dir, exist_ok=True)
     blob, md = {}, []
     for key in keys:
         out = os.path.join(out_root, key)
-        result = collect(campaign.load_campaign(CAMPAIGNS[key]), out)
+        result = collect(load(key), out)
         if not any(p["metrics"] for p in result["points"]):
             md.append(f"{key}: no complete run in {out}")
             continue
@@ -388,8 +529,28 @@ def report(keys, out_root, report_dir):
         blob[key] = dict(stats, timing=read_timing(out), runs_timing=result["runs_timing"],
                          campaign=CAMPAIGNS[key], campaign_digest=result["campaign"]["digest"])
         md += [f"### {key}: {stats['draws_max']} draws (every group: {stats['draws']})", "",
-               *_fmt_rows(stats["rows"], key), "", *_fmt_pairs(stats["pairs"], stats["labels"]), "",
-               timing_line(key, out, result["runs_timing"]), ""]
+               *(["Table 1's heading read as " + ("yaw +15 deg (PSINS's counter-clockwise yaw; yaw "
+                  "error +1')" if CONVENTION["name"] == "ccw" else "a clockwise heading (yaw -15 deg, "
+                  "yaw error -1')") + f" (--convention {CONVENTION['name']}).", ""] if key == "seed002" else []),
+               *_fmt_rows(stats["rows"], key), "", *_fmt_pairs(stats["pairs"], stats["labels"]), ""]
+        if key == "seed002":
+            vec = draw_vectors(load(key), out)
+            cache = os.path.join(out, f"up_gyro_response_{CONVENTION['name']}.json")
+            if os.path.exists(cache):
+                with open(cache) as f:
+                    up = json.load(f)
+            else:
+                up = up_gyro_response(CONVENTION["name"])
+                with open(cache, "w") as f:
+                    json.dump(up, f)
+            j = joint(vec, paper_figures(key), up)
+            blob[key]["joint"] = j
+            with open(os.path.join(report_dir, "montecarlo_draws.json"), "w") as f:
+                json.dump({"convention": CONVENTION["name"], "unit": "nmi",
+                           "fields": "north, east (final), max horizontal", "draws": vec}, f, indent=0)
+            md += ["#### The paper's six figures at once, and the schemes beside the shared up-gyro floor", "",
+                   *_fmt_joint(j, stats["labels"]), ""]
+        md += [timing_line(key, out, result["runs_timing"]), ""]
     with open(os.path.join(report_dir, "montecarlo.json"), "w") as f:
         json.dump(blob, f, indent=1, allow_nan=True)
     text = "\n".join(md)
@@ -470,7 +631,11 @@ def main(argv=None):
                          "the first N draws of seed003_montecarlo on Dask against the local runs in --out")
     ap.add_argument("--dask-draws", type=int, default=0)
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--convention", choices=sorted(CONVENTIONS), default="ccw",
+                    help="seed 002's Table 1 heading: ccw = yaw +15 deg (PSINS, adopted; default), "
+                         "clockwise = yaw -15 deg (the built-in scenarios)")
     a = ap.parse_args(argv)
+    CONVENTION["name"] = a.convention
     keys = a.seeds or list(CAMPAIGNS)
     for key in keys:
         if key not in CAMPAIGNS:
@@ -491,7 +656,7 @@ def main(argv=None):
         return 0 if same else 1
     if not a.report_only:
         for key in keys:
-            camp_schemes = campaign.load_campaign(CAMPAIGNS[key]).grid["indexing.scheme"]
+            camp_schemes = load(key).grid["indexing.scheme"]
             schemes = [s for s in a.schemes.split(",") if s in camp_schemes] if a.schemes else None
             run_seed(key, a.draws, a.block, os.path.join(a.out, key), a.workers, a.scheduler, a.quiet,
                      schemes)
