@@ -29,8 +29,8 @@ conversions used by the presets: 1 deg/sqrt(h) = DEG_TO_RAD / 60 rad/sqrt(s);
    project reads them, docs/papers.md).
 5. Random-constant draws: `random_constant_values`, `random_constant_overrides`,
    `draw_random_constants` (each random constant of a preset drawn as
-   N(0, sigma^2) with sigma its preset value; Monte-Carlo campaigns,
-   docs/results/montecarlo.md).
+   N(0, sigma^2) with sigma its preset value: production units of the
+   grade a paper describes; Monte-Carlo campaigns, docs/results/montecarlo.md).
 """
 from dataclasses import dataclass, field, replace
 
@@ -218,7 +218,9 @@ PRESETS = {
     # IMU), so they are zero here.
     "seed000": SensorErrors(gyro_bias=np.full(3, 0.01 * _DPH),
                             accel_bias=np.full(3, 100.0 * _UG)),
-    # Seed 001 (docs/papers.md, seed 001 §3): drift [0.01 0.01 0.01] deg/h;
+    # Seed 001 (docs/papers.md, seed 001 §3): PSINS's imuerrset(1) = imuerrset(0.01, 100,
+    # 0.001, 10), the set the paper simulated (docs/papers.md, "How the papers built their
+    # error sets"; tests/papers/test_presets_psins.py): drift [0.01 0.01 0.01] deg/h;
     # gyro noise Q = diag(1e-3 deg/h)^2 "as printed", interpreted as an ARW of
     # 0.001 deg/sqrt(h); accelerometer bias 100 ug; accelerometer noise
     # Q = diag(10 ug)^2 interpreted as a VRW of 10 ug/sqrt(Hz).
@@ -226,7 +228,9 @@ PRESETS = {
                             gyro_arw=0.001 * DPSH_TO_RPSS,
                             accel_bias=np.full(3, 100.0 * _UG),
                             accel_vrw=10.0 * UGPSHZ_TO_MPSPSS),
-    # Seed 002 (docs/papers.md, seed 002 §7, Table 2): drift 0.003 deg/h,
+    # Seed 002 (docs/papers.md, seed 002 §7, Table 2), as PSINS's imuerrset(0.003, 30, 0.0005,
+    # 5, [], [], [], [], 10, 10, 10, 10) builds it, the set the paper simulated (every term
+    # +its value; tests/papers/test_presets_psins.py): drift 0.003 deg/h,
     # bias 30 ug (ug likely), ARW 0.0005 deg/sqrt(h), VRW 5 ug/sqrt(Hz)
     # (likely), scale factors 10 ppm on both triads (likely), six gyro
     # installation terms 10" (all off-diagonal), three accelerometer terms
@@ -278,7 +282,7 @@ def preset(name, gyro_bias_signs=(1.0, 1.0, 1.0), accel_bias_signs=(1.0, 1.0, 1.
 
 
 # ---------------------------------------------------------------------------
-# 5. Random-constant draws (Monte Carlo over the papers' stated 1-sigma values)
+# 5. Random-constant draws (Monte Carlo over production units, the stated values as 1 sigma)
 # ---------------------------------------------------------------------------
 #: The terms a paper states as random constants, in the order their standard
 #: normals are drawn, with the unit a scenario file writes them in.
@@ -315,8 +319,11 @@ def random_constant_values(name, draw):
     """Draw ``draw`` of preset ``name``'s random constants, in file units.
 
     The papers state their drifts, biases, scale-factor and installation
-    errors as random constants (随机常值) with a 1-sigma value; the presets
-    hold +1 sigma on every term, one particular draw. Here every term that
+    errors as random constants (随机常值) with one value each; the presets
+    hold that value with a plus sign on every term, the set the papers
+    simulated (PSINS's imuerrset, docs/papers.md "How the papers built their
+    error sets"). Here, to spread the figures over production units
+    (docs/results/montecarlo.md), every term that
     is non-zero in the preset is drawn independently as N(0, sigma^2) with
     sigma = |preset value| (signs and magnitudes both random); terms the
     preset leaves zero stay zero (e.g. seed 002's upper-triangle
