@@ -189,8 +189,9 @@ def explain(r, hours):
                 f"- **The traditional scheme on the horizontal drifts alone does not fail here** (the "
                 f"paper: {p_tr:.2f} nmi, 'basically fails'): the decoded swing has a 60 s period, and "
                 f"every 300-s stop covers exactly 5 periods, so the x/y drift cancels almost perfectly "
-                f"(survival {sv[1]:.4f}, {hd[1]:.3f} nmi with horizontal drifts only; the idealised check "
-                f"of docs/papers.md, seed 002 §10, printed 0.0004 for the stops alone). The paper's "
+                f"(survival {sv[1]:.4f}, {hd[1]:.3f} nmi with horizontal drifts only, {svt[1]:.4f} of it left "
+                f"in the turns; the idealised check of docs/papers.md, seed 002 §10, with ideal "
+                f"constant-rate turns printed 0.0004). The paper's "
                 f"text says the swing period equals the stop time, which the decoded formula does "
                 f"not give; nothing was changed to match.",
                 f"- **With every error of Table 2 it does fail, through another mechanism**: "
