@@ -68,6 +68,54 @@ def reduced_truth(limits, phi_true=np.zeros(3)):
     return np.concatenate([phi_hat, eps_hat])
 
 
+
+def swing_cubic(radius, period, swing, window, phases=72, points=400):
+    """The largest t^3 coefficient [m/s^3] a swing at anchor puts into a
+    window of ``window`` seconds, over the swing's phase at the window's
+    start: the reference point on the chain's circle (`pyins.sim.ship.
+    anchor_linear`: radius [m], period [s], half angle ``swing`` [rad]),
+    its horizontal displacement fitted by least squares with a cubic in
+    time, the cubic term's norm. The moving-base filter reads heading from
+    that term (csrc/src/moving_align.hpp: p_N = -(1/6) g W cos L phi_U
+    t^3), so a swing whose cubic is c looks like a heading error of
+    6 c / (g W cos L). For a window well inside a period it is the
+    displacement's third derivative / 6 (Taylor; r swing w^3 / 6 at most,
+    w = 2 pi / period); once the window holds a few periods it falls as
+    window^-3."""
+    t = np.linspace(0.0, window, points)
+    basis = np.vander(t / window, 4, increasing=True)
+    pinv = np.linalg.pinv(basis)[3] / window ** 3
+    best = 0.0
+    for ph in np.linspace(0.0, 2.0 * np.pi, phases, endpoint=False):
+        theta = swing * np.sin(2.0 * np.pi * t / period + ph)
+        c = pinv @ np.stack([-radius * np.sin(theta), radius * (1.0 - np.cos(theta))], axis=1)
+        best = max(best, float(np.hypot(c[0], c[1])))
+    return best
+
+
+def site_accel_for_swing(radius, period, swing, longest=None):
+    """The site-motion density q [m/s^2/sqrt(Hz)] (the firmware's
+    ``fine_site_accel``) under which the moving-base filter's heading sigma
+    covers a swing at anchor of ``radius`` [m], ``period`` [s] and half
+    angle ``swing`` [rad] at every alignment length up to ``longest`` [s]
+    (default three periods).
+
+    Told q, the filter takes the site's displacement as an integrated
+    random walk, whose t^3 coefficient over a window T has the sigma
+    q / sqrt(3 T^3) (csrc/src/moving_align.hpp: the Fisher information 3
+    k^2 T^3 / q^2 of the heading, k = g W cos L / 6). The swing's own
+    cubic (`swing_cubic`) is c(T), so q = max over T of c(T) sqrt(3 T^3)
+    makes the site's share of the heading sigma at least the heading the
+    swing can fake at every T: the filter's sigma, and with it ATT_VALID,
+    then holds for every swing up to this one (any phase, any heading of
+    the ship). The maximum lies near T = period. A bound of the anchorage
+    (the chain's radius, the fastest swing, the widest angle) gives the
+    q to configure; a smaller swing is covered by it.
+    """
+    longest = 3.0 * period if longest is None else float(longest)
+    windows = np.geomspace(10.0, longest, 120)
+    return max(swing_cubic(radius, period, swing, w) * np.sqrt(3.0 * w ** 3) for w in windows)
+
 # ---------------------------------------------------------------------------
 # Linear error model of a static INS (an error-budget tool)
 # ---------------------------------------------------------------------------

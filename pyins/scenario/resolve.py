@@ -14,7 +14,7 @@ import re
 
 import numpy as np
 
-from pyins import sim
+from pyins import analysis, sim
 from pyins.scenario.build import _build_motion, _is_ship, _spectrum_motion
 from pyins.scenario.schema import (COMPONENT_KEYS, FIGURE_KEYS, FIRMWARE_KEYS, INDEX_SCHEMES,
                                    INDEXING_KEYS, INITIAL_ERROR_KEYS, METRICS, MOTION_COMMON,
@@ -290,7 +290,41 @@ def _resolve_firmware(table, duration_s):
         key = "firmware.fine_time" if v["fine_time"] else "firmware.coarse_time"
         raise ScenarioError(f"out of range: the alignment ({align:g} s) is longer than the duration "
                             f"({duration_s:g} s)", key)
+    swing = v.pop("fine_site_swing")
+    if swing is not None:
+        v["fine_site_accel"] = _site_accel_of_swing(swing, v["fine_site_accel"])
     return _si(v, FIRMWARE_KEYS)
+
+
+#: fine_site_accel's upper limit [m/s^2/sqrt(Hz)] (schema: 10 mg/sqrt(Hz))
+_SITE_ACCEL_MAX = 10e-3 * 9.80665
+
+
+def _site_accel_of_swing(raw, site_accel):
+    """fine_site_swing = [radius, period, half angle] -> the density q
+    that covers the swing (`analysis.site_accel_for_swing`)."""
+    where = "firmware.fine_site_swing"
+    if site_accel is not None:
+        raise ScenarioError("give fine_site_swing or fine_site_accel, not both (the swing sets the "
+                            "density)", where)
+    if len(raw) != 3:
+        raise ScenarioError(f"must be [radius, period, half angle], got {len(raw)} values", where)
+    radius = parse_quantity(raw[0], "length", where=f"{where}[0]")
+    period = parse_quantity(raw[1], "time", where=f"{where}[1]")
+    half = parse_quantity(raw[2], "angle", where=f"{where}[2]")
+    if not 0.0 < radius <= 1000.0:
+        raise ScenarioError(f"out of range: radius {radius:g} m, must be within (0, 1000] m", f"{where}[0]")
+    if not 60.0 <= period <= 86400.0:
+        raise ScenarioError(f"out of range: period {period:g} s, must be within 1 min .. 1 d", f"{where}[1]")
+    if not 0.0 < half <= math.pi / 2.0:
+        raise ScenarioError(f"out of range: half angle {half / DEG_TO_RAD:g} deg, must be within (0, 90] deg",
+                            f"{where}[2]")
+    q = analysis.site_accel_for_swing(radius, period, half)
+    if q > _SITE_ACCEL_MAX:
+        raise ScenarioError(f"this swing needs a site density of {q / 9.80665e-6:.0f} ug/sqrt(Hz), beyond the "
+                            "firmware's 10 mg/sqrt(Hz): no alignment without a reference can cover it",
+                            where)
+    return q
 
 
 def _windows(raw, where, duration_s):

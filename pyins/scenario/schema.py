@@ -324,6 +324,11 @@ FIRMWARE_KEYS = {
                                                    "a white acceleration density (firmware default 0: "
                                                    "a rigid site)", lo="0 ug/sqrt(Hz)",
                            hi="10 mg/sqrt(Hz)"),
+    "fine_site_swing": Key("list", "moving base (fine_states 12) at anchor: the anchorage's bound on the "
+                                   "swing, [radius, period, half angle] (e.g. [\"80 m\", \"20 min\", "
+                                   "\"30 deg\"]: the chain's radius, the fastest swing, the widest); "
+                                   "sets fine_site_accel to the density that covers every swing up to "
+                                   "it (pyins.analysis.site_accel_for_swing; not with fine_site_accel)"),
     "nav_gyro_bias_rw": Key("rate_random_walk", "navigation filter: the gyro biases' random walk, "
                                                 "their instability (firmware default 0: random "
                                                 "constants)", lo="0 deg/h/sqrt(h)",
