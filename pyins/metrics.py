@@ -40,7 +40,7 @@ import numpy as np
 
 from pyins import analysis, sim
 from pyins.reference import abi, attitude, earth
-from pyins.reference.fine_align import EPS, EPS_NU
+from pyins.reference.fine_align import EPS, EPS_NU, PHI
 from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, NMI_TO_M, TWO_PI, UNITS)
 
 __all__ = ["Metric", "TABLE", "NAMES", "FIGURE_METRICS", "RUN_METRICS", "GROUP_METRICS", "NavErrors",
@@ -392,3 +392,58 @@ def display(name, values_si=()):
         return ("nmi", NMI_TO_M) if big > 0.5 * NMI_TO_M else ("m", 1.0)
     m = _BY_NAME.get(name)
     return (m.unit, m.scale) if m else ("", 1.0)
+
+
+# ---------------------------------------------------------------------------
+# Which alignment ran and how sure it was (a run's and a replay's summary)
+# ---------------------------------------------------------------------------
+#: enum pyins_coarse_method's names, as the scenario files write them
+COARSE_NAMES = {abi.PYINS_COARSE_TRIAD: "TRIAD", abi.PYINS_COARSE_FIT: "FIT", abi.PYINS_COARSE_EQ8: "EQ8",
+                abi.PYINS_COARSE_FIT_VEL: "FIT_VEL (under way)"}
+
+
+def alignment_method(cfg, hz):
+    """Which alignment ran, in words, from the firmware configuration ``cfg``
+    (a dict of pyins_config fields; an absent field the firmware's default)
+    at ``hz`` ticks a second: its coarse method and length, then the fine
+    filter or the navigation filter that refined it; None when the run does
+    not align (it starts navigating from the configured attitude)."""
+    parts = []
+    if cfg.get("coarse_ticks", 0) > 0:
+        name = COARSE_NAMES.get(cfg.get("coarse_method", abi.PYINS_COARSE_TRIAD), "unknown")
+        parts.append(f"coarse {name} {cfg['coarse_ticks'] / hz:g} s")
+    if cfg.get("fine_ticks", 0) > 0:
+        states = cfg.get("fine_states") or 5
+        parts.append(f"fine {states}-state {'moving-base ' if states == 12 else ''}filter "
+                     f"{cfg['fine_ticks'] / hz:g} s")
+    if not parts:
+        return None
+    if cfg.get("nav_mode", abi.PYINS_NAV_AUTO) != abi.PYINS_NAV_UNDAMPED:
+        parts.append("the navigation filter while a reference aids it")
+    return ", then ".join(parts)
+
+
+def alignment_heading_sigma(rec):
+    """The heading sigma [arcmin] of a record (the first in navigation: as
+    navigation began): the navigation filter's, else the fine filter's;
+    None where no filter estimates it (a coarse alignment alone, undamped)."""
+    if rec["nav_sigma_heading_rad"] > 0.0:
+        return float(rec["nav_sigma_heading_rad"]) / ARCMIN_TO_RAD
+    if rec["kf_states"]:
+        return float(rec["kf_sigma"][PHI][2]) / ARCMIN_TO_RAD
+    return None
+
+
+def aligned(cfg, hz, outputs):
+    """A run's alignment for its summary: {"method", "time_s" (navigation
+    began), "heading_sigma_arcmin" (then)}; None when it does not align or
+    never reached navigation."""
+    method = alignment_method(cfg, hz)
+    if method is None or not len(outputs):
+        return None
+    nav = np.flatnonzero(outputs["mode"] == abi.PYINS_MODE_NAVIGATE)
+    if not len(nav):
+        return None
+    first = outputs[nav[0]]
+    return dict(method=method, time_s=float(first["tick"]) / hz, heading_sigma_arcmin=alignment_heading_sigma(first))
+

@@ -105,38 +105,6 @@ def _parked_errors(recs, cfg, hz):
     return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, vel_n_mps=e.vel_n_mps)
 
 
-#: enum pyins_coarse_method's names, as the scenario files write them
-COARSE_NAMES = {abi.PYINS_COARSE_TRIAD: "TRIAD", abi.PYINS_COARSE_FIT: "FIT", abi.PYINS_COARSE_EQ8: "EQ8",
-                abi.PYINS_COARSE_FIT_VEL: "FIT_VEL (under way)"}
-
-
-def alignment_method(cfg, hz):
-    """Which alignment ran, in words: its coarse method and length, then the
-    fine filter or the navigation filter that refined it."""
-    parts = []
-    if cfg.get("coarse_ticks", 0) > 0:
-        name = COARSE_NAMES.get(cfg.get("coarse_method", abi.PYINS_COARSE_TRIAD), "unknown")
-        parts.append(f"coarse {name} {cfg['coarse_ticks'] / hz:g} s")
-    if cfg.get("fine_ticks", 0) > 0:
-        states = cfg.get("fine_states") or 5
-        parts.append(f"fine {states}-state {'moving-base ' if states == 12 else ''}filter "
-                     f"{cfg['fine_ticks'] / hz:g} s")
-    if cfg.get("nav_mode", abi.PYINS_NAV_AUTO) != abi.PYINS_NAV_UNDAMPED:
-        parts.append("the navigation filter while a reference aids it")
-    return ", then ".join(parts)
-
-
-def _heading_sigma(rec):
-    """The heading sigma [arcmin] of the first navigation record: the
-    navigation filter's, else the fine filter's; None where no filter
-    estimates it (a coarse alignment alone, undamped)."""
-    if rec["nav_sigma_heading_rad"] > 0.0:
-        return float(rec["nav_sigma_heading_rad"]) / ARCMIN_TO_RAD
-    if rec["kf_states"]:
-        return float(rec["kf_sigma"][PHI][2]) / ARCMIN_TO_RAD
-    return None
-
-
 class _Summary:
     """What the summary needs of the records, gathered block by block: the
     first and last record, the first record in navigation, the last of the
@@ -219,8 +187,8 @@ class _Summary:
             pitch, roll, yaw = np.degrees(first["euler_b_rad"][0])
             summary["aligned"] = dict(time_s=float(first["tick"][0] / hz), pitch_deg=float(pitch),
                                       roll_deg=float(roll), heading_deg=float(np.mod(-yaw, 360.0)),
-                                      method=alignment_method(cfg, hz),
-                                      heading_sigma_arcmin=_heading_sigma(first[0]))
+                                      method=metrics.alignment_method(cfg, hz),
+                                      heading_sigma_arcmin=metrics.alignment_heading_sigma(first[0]))
         # the filter's state at the end of the fine alignment: the first record of navigation
         # holds it (the last fine record is up to a record interval before the end)
         end = None if self.first_nav is None else self.first_nav[0]

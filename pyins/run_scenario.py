@@ -149,6 +149,9 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
                         finished = True
                 entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
                              complete=bool(info and info.get("complete")), metrics=mm)
+                al = metrics.aligned(spec.config, 1.0 / spec.dt, res.outputs) if res is not None else None
+                if al is not None:
+                    entry["aligned"] = al
             except KeyboardInterrupt as exc:
                 # at once: the ticks on disk; the metrics of a stopped variant are the report's
                 interrupted = interrupted or exc.with_traceback(None)

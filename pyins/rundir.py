@@ -105,6 +105,11 @@ def _summary_problem(summary):
     for v in vs:
         if not isinstance(v.get("metrics", {}), dict) or not isinstance(v.get("ticks", 0), int):
             return f"has a damaged entry for variant {v['label']!r} (metrics, ticks)"
+        al = v.get("aligned")
+        if al is not None and not (isinstance(al, dict) and isinstance(al.get("method"), str)
+                                   and isinstance(al.get("time_s"), (int, float))
+                                   and isinstance(al.get("heading_sigma_arcmin"), (int, float, type(None)))):
+            return f"has a damaged entry for variant {v['label']!r} (aligned)"
     return None
 
 

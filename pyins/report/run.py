@@ -494,6 +494,12 @@ def _component_rows(summary, series):
     ]
 
 
+def _aligned_cell(al):
+    sigma = al.get("heading_sigma_arcmin")
+    return (f"{al['method']}; navigating at {al['time_s']:g} s"
+            + (f", heading sigma {sigma:.3g}'" if sigma is not None else ", no heading sigma (no filter)"))
+
+
 def _results_tables(summary, series):
     """The results: a row per metric, a column per variant, at most
     VARIANTS_PER_TABLE variants a table."""
@@ -506,6 +512,10 @@ def _results_tables(summary, series):
                      {v["label"]: f"{v['metrics'][k] / unit[1]:.4g} {unit[0]}" for v in variants
                       if k in v["metrics"]}))
     rows += _component_rows(summary, series)
+    aligned = {v["label"]: _aligned_cell(v["aligned"]) for v in variants if v.get("aligned")}
+    if aligned:
+        rows.append(("alignment", "which alignment ran, and the heading sigma it reported as navigation "
+                     "began (the navigation filter's, else the fine filter's)", aligned))
     out = []
     for i in range(0, len(variants), VARIANTS_PER_TABLE):
         part = variants[i:i + VARIANTS_PER_TABLE]

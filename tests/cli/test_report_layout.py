@@ -424,3 +424,62 @@ def test_a_long_replays_figures_keep_every_peak(tmp_path, drawn):
         part = pitch[(x >= a) & (x < a + 2000)]
         assert part.max() > 1.99 and part.min() < -1.99, a
     assert drawn["errors.png"][0]["lines"][0][2].max() == 42.0
+
+
+# ---------------------------------------------------------------------------
+# Which alignment ran: the summary and the report say it
+# ---------------------------------------------------------------------------
+ALIGNED = """
+name = "aligned"
+title = "a static IMU aligned by FIT, then the 8-state filter, then navigating"
+duration = "300 s"
+seed = 3
+record_every = "1 s"
+[motion]
+kind = "static"
+lat = "34 deg"
+lon = "108 deg"
+height = "0 m"
+heading = "30 deg"
+[sensors]
+preset = "seed000"
+[firmware]
+initial_attitude = "zero"
+coarse_time = "60 s"
+coarse_method = "fit"
+fine_time = "120 s"
+fine_states = 8
+[compare]
+key = "firmware.fine_time"
+values = ["120 s", "0 s"]
+labels = ["fine", "coarse only"]
+"""
+
+
+def test_a_run_names_its_alignment_in_the_summary_and_the_report(tmp_path):
+    out = _run(tmp_path, ALIGNED)
+    summary = rundir.read_summary(str(out))
+    fine, coarse = summary["variants"]
+    # the method as configured, the time navigation began and the sigma then: the
+    # 8-state filter's heading sigma after 120 s (tens of arc-minutes on a static
+    # base: well above 0, well below its 600' prior); the coarse alignment alone
+    # has no filter to say it
+    assert fine["aligned"]["method"] == ("coarse FIT 60 s, then fine 8-state filter 120 s, then the "
+                                         "navigation filter while a reference aids it")
+    assert fine["aligned"]["time_s"] == 180.0
+    assert 0.0 < fine["aligned"]["heading_sigma_arcmin"] < 600.0
+    assert coarse["aligned"]["method"].startswith("coarse FIT 60 s, then the navigation filter")
+    assert coarse["aligned"]["time_s"] == 60.0
+    page = html.unescape(open(report.render(str(out))).read())
+    row = page.split("<code>alignment</code>", 1)[1].split("</tr>", 1)[0]
+    assert "coarse FIT 60 s, then fine 8-state filter 120 s" in row and "navigating at 180 s" in row
+    assert f"heading sigma {fine['aligned']['heading_sigma_arcmin']:.3g}'" in row
+
+
+def test_a_damaged_aligned_entry_is_named(tmp_path):
+    out = _run(tmp_path, ALIGNED)
+    summary = rundir.read_summary(str(out))
+    summary["variants"][0]["aligned"] = "FIT"
+    rundir.write_summary(str(out), summary)
+    with pytest.raises(rundir.RunDirError, match="damaged entry for variant 'fine' \\(aligned\\)"):
+        rundir.summary_for_report(str(out))
