@@ -128,3 +128,21 @@ def test_scenario_fine_site_swing_and_density_are_not_both_given():
     with pytest.raises(ScenarioError, match="fine_site_swing or fine_site_accel, not both"):
         next(iter(_anchor_unaided(fine_site_swing=["80 m", "20 min", "30 deg"],
                                   fine_site_accel="1000 ug/sqrt(Hz)").runs()))
+
+
+def test_the_mirror_aligns_alike_at_anchor():
+    """The alignments at anchor through the C++ core and through the NumPy
+    mirror (firmware and plant), 600 s each: `at_anchor` (GNSS, the table
+    indexed) and the unaided moving-base filter told the anchorage's swing
+    (fine_site_swing, 480 s): every decision identical, the floats within
+    tests/engines.py's bounds."""
+    from engines import assert_engines_agree
+    from pyins.run_scenario import run
+    unaided = {"references": None, "indexing.scheme": "none", "firmware.fine_time": "480 s",
+               "firmware.fine_states": 12, "firmware.fine_site_swing": ["80 m", "20 min", "30 deg"]}
+    for over in ({}, unaided):
+        spec = next(iter(scenario.load("at_anchor").with_overrides(over).runs()))
+        a = run(spec).outputs
+        b = run(spec, engine="reference").outputs
+        assert len(a) == len(b) == 600
+        assert_engines_agree(a, b, nis_abs=1e-6)
