@@ -7,11 +7,17 @@ summed are overrides of them. This driver adds the analysis and the report.
     .venv/bin/python tools/papers/reproduce_seed002.py [--out runs/seed002] [--hours 72]
         [--convention ccw|clockwise|ccw_start]
     .venv/bin/python tools/papers/reproduce_seed002.py --conventions   # Table 2 rows, both readings
+                                                                        # (conventions.md)
 
 Experiments 1 and 2 (heading swing omega = 6 cos(pi t/60) and 6 cos(pi t/30)
 deg/s), its Table 1 initial state and initial errors (pitch/roll/heading
 -10", 10", 1'; velocity 0.01 m/s; position 10 m north and east), its Table 2
-sensor errors (preset seed002), for no rotation, the traditional two-position
+sensor errors (preset seed002: the paper's set as PSINS's imuerrset builds it,
+every term +its value; docs/papers.md, "How the papers built their error
+sets"), Table 1's 15-deg heading read as the built-in scenarios read it, a
+clockwise heading (yaw -15 deg; --convention ccw reads it as PSINS's
+counter-clockwise yaw +15 deg, the reading adopted for the comparison with
+the paper, and --conventions runs the Table 2 rows both ways), for no rotation, the traditional two-position
 scheme and the flexible scheme (stops 300 s, 6 deg/s), literal (docs/papers.md,
 seed 002 §6, scheme 4) and in the form of its derivation (eqs. 9-13, scheme 6). The
 paper's turns run at a constant 6 deg/s: we command 600 deg/s^2, which
