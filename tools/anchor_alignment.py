@@ -13,12 +13,15 @@ the swing's phase 72 h + 144 s deg. Seed 000's sensor errors, drawn per
 cell from its 1-sigma values (`pyins.sim.sensors.draw_random_constants`,
 draw 6 s + h).
 
-Alignments per cell, each from nothing (FIT coarse alignment 120 s); the
-receiver's noise seed 100 + 10 h + s:
-- ``gnss``: the built-in `at_anchor`: the navigation filter aided by GNSS
-  (3 m, 0.05 m/s at 1 Hz) with the table indexed, 480 s;
+Alignments per cell, each from nothing; the receiver's noise seed 100 +
+10 h + s:
+- ``gnss``: the built-in `at_anchor`: FIT coarse 60 s, then the navigation
+  filter aided by GNSS (3 m, 0.05 m/s at 1 Hz) with the table indexed,
+  540 s;
 - ``gnss_fixed``: the same with the table fixed (the static limit holds);
-- ``none``: no reference: the moving-base 12-state fine alignment, 2880 s,
+- ``none``: no reference: FIT coarse 120 s (its wander test needs the
+  waves' periods well below a fifth of it, docs/results/harbour.md), then
+  the moving-base 12-state fine alignment, 2880 s,
   told the anchorage's bound on the swing (``fine_site_swing`` = the grid's
   largest radius, fastest swing and its half angle, 80 m, 20 min, 30 deg:
   ``fine_site_accel`` 4015 ug/sqrt(Hz), `pyins.analysis.
@@ -76,8 +79,9 @@ def one(h, s, method):
         over["indexing.scheme"] = "none"
     elif method in NONE_FINE_S:
         fine = NONE_FINE_S[method]
-        over.update({"indexing.scheme": "none", "references": None, "firmware.fine_time": f"{fine} s",
-                     "firmware.fine_states": 12, "duration": f"{fine + 120} s"})
+        over.update({"indexing.scheme": "none", "references": None, "firmware.coarse_time": "120 s",
+                     "firmware.fine_time": f"{fine} s", "firmware.fine_states": 12,
+                     "duration": f"{fine + 120} s"})
         if method == "none":
             over["firmware.fine_site_swing"] = SWING_BOUND
         elif method == "none_harbour":
@@ -138,8 +142,8 @@ def main():
                   + ", ".join(str(row[f"{m}_valid_when_off"]) for m in METHODS)
                   + f" records ({time.perf_counter() - t0:.0f} s)", flush=True)
     n = len(rows)
-    lines = [f"{n} cells ({args.headings} headings x {args.seeds} seeds), FIT coarse 120 s; median |heading "
-             f"error| at 600 s, and the worst:"]
+    lines = [f"{n} cells ({args.headings} headings x {args.seeds} seeds), FIT coarse 60 s (with GNSS) or 120 s "
+             f"(none); median |heading error| at 600 s, and the worst:"]
     for m in METHODS:
         a = np.abs([r[f"{m}_arcmin"] for r in rows])
         d = np.abs([r[f"{m}_arcmin"] - r["limit_arcmin"] for r in rows])
