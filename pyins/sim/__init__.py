@@ -39,7 +39,7 @@ from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, eule
                            truth_at)
 from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
                           save_npz)
-from pyins.sim.motion import (SEA_STATES, HeadingSwing, Manoeuvre, Motion, MotionState, Segment,
+from pyins.sim.motion import (SEA_STATES, HeadingSwing, Manoeuvre, Motion, MotionState, NarrowbandYaw, Segment,
                               Static, Swing, default_segments, periodic_ticks, sea_state)
 from pyins.sim.sensors import PRESETS, SensorErrors, SensorModel, preset
 from pyins.sim.ship import (AT_ANCHOR, MOORED_SHIP, SEA_STATE_SPECTRA, LinearMotion, ShipAtSea, anchor_linear,
@@ -52,7 +52,7 @@ __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
     "exact_increments", "generate", "nb_rate_and_derivative", "node_rates", "truth", "truth_at",
     "CSV_COLUMNS", "CSV_HEADER", "ImuData", "load_csv", "load_npz", "save_csv", "save_npz",
-    "SEA_STATES", "HeadingSwing", "Manoeuvre", "Motion", "MotionState", "Segment", "Static",
+    "SEA_STATES", "HeadingSwing", "Manoeuvre", "Motion", "MotionState", "NarrowbandYaw", "Segment", "Static",
     "Swing", "default_segments", "sea_state",
     "PRESETS", "SensorErrors", "SensorModel", "preset",
     "Voyage", "default_voyage",

@@ -326,6 +326,104 @@ class HeadingSwing(Swing):
                    SEED002_ROLL, yaw0, a_deg * DEG_TO_RAD, period)
 
 
+class NarrowbandYaw(Motion):
+    """A ship's random narrowband yaw at a fixed position: seed 002's
+    heading swing made random (the claims issue: the scheme ranking of
+    seed 002 rests on a perfect sinusoid; a sea's yaw is not one).
+
+    yaw(t) = yaw0 + sum_k a_k sin(2 pi f_k t + phi_k); pitch and roll held
+    constant; velocity zero. The spectrum is the linear wave-response
+    model of Fossen (Handbook of Marine Craft Hydrodynamics and Motion
+    Control, 2011, sec. 8.2.4, eq. 8.118): the yaw angle the output of
+    h(s) = K s / (s^2 + 2 lambda w0 s + w0^2) driven by white noise, so its
+    density is S(w) ~ w^2 / ((w0^2 - w^2)^2 + (2 lambda w0 w)^2), peaked at
+    the encounter frequency w0 = 2 pi / ``peak_period`` with relative
+    damping ``damping`` (Fossen's 0.1 for a narrow sea). It is sampled on
+    the frequencies f_k = k / ``repeat_s`` within [f0 / 3, 3 f0] (the
+    random-phase method: a_k^2 / 2 = S(w_k) dw, phi_k uniform from
+    ``seed``), scaled so that the yaw rate's RMS is ``rms_rate``. The yaw
+    repeats after ``repeat_s`` (1801 s by default: half an hour, a prime
+    number of seconds, so that no indexing cycle of whole seconds shares its
+    period), which lets the closed loop compute its rates once
+    (`periodic_ticks`): a random yaw for half an hour, then the same again.
+
+    Parameters
+    ----------
+    lat, lon, height : float
+        Position [rad, rad, m].
+    pitch, roll, yaw0 : float
+        Constant pitch and roll, mean yaw [rad].
+    rms_rate : float
+        The yaw rate's RMS [rad/s] (seed 002's sinusoid A cos: A / sqrt 2).
+    peak_period : float
+        2 pi / w0 [s].
+    seed : int
+        The phases' draw.
+    damping : float
+        lambda.
+    repeat_s : int
+        The period of the realisation [s].
+    """
+
+    def __init__(self, lat, lon, height, pitch, roll, yaw0, rms_rate, peak_period, seed,
+                 damping=0.1, repeat_s=1801):
+        self.lat, self.lon, self.height = float(lat), float(lon), float(height)
+        self.pitch, self.roll, self.yaw0 = float(pitch), float(roll), float(yaw0)
+        if not (rms_rate >= 0.0 and peak_period > 0.0 and 0.0 < damping < 1.0 and int(repeat_s) > 0):
+            raise ValueError("NarrowbandYaw: rms_rate >= 0, peak_period > 0, 0 < damping < 1, repeat_s > 0")
+        f0 = 1.0 / float(peak_period)
+        k = np.arange(max(1, int(np.ceil(f0 / 3.0 * repeat_s))), int(np.floor(3.0 * f0 * repeat_s)) + 1)
+        self.freq = k / float(repeat_s)
+        w, w0 = TWO_PI * self.freq, TWO_PI * f0
+        density = w * w / ((w0 * w0 - w * w) ** 2 + (2.0 * damping * w0 * w) ** 2)
+        amp = np.sqrt(2.0 * density)                    # dw common to all: the scale absorbs it
+        rate_rms = np.sqrt(0.5 * np.sum((amp * w) ** 2))
+        self.amp = amp * (float(rms_rate) / rate_rms) if rate_rms > 0.0 else amp * 0.0
+        self.phase = np.random.default_rng(seed).uniform(0.0, TWO_PI, len(k))
+        self.rms_rate, self.peak_period, self.damping = float(rms_rate), float(peak_period), float(damping)
+        self.repeat_s, self.seed = int(repeat_s), seed
+
+    @property
+    def frequencies_hz(self):
+        return tuple(float(f) for a, f in zip(self.amp, self.freq) if a != 0.0)
+
+    def _yaw(self, t, t_lo, accel=False):
+        """(yaw - yaw0, yaw rate) at t, or the yaw's second derivative with
+        ``accel``: one phase, one sine and one cosine per component."""
+        t, t_lo = as_times(t, t_lo)
+        a0 = np.zeros(t.shape[0])
+        a1 = np.zeros(t.shape[0])
+        for a, f, ph in zip(self.amp, self.freq, self.phase):
+            x = TWO_PI * frac_cycles(f, t, t_lo) + ph
+            w = TWO_PI * f
+            if accel:
+                a0 -= (a * w * w) * np.sin(x)
+            else:
+                a0 += a * np.sin(x)
+                a1 += (a * w) * np.cos(x)
+        return a0, a1
+
+    def state(self, t, t_lo=None):
+        t, t_lo = as_times(t, t_lo)
+        n = t.shape[0]
+        yaw, yaw_rate = self._yaw(t, t_lo)
+        euler = np.empty((n, 3))
+        euler[:, 0], euler[:, 1] = self.pitch, self.roll
+        euler[:, 2] = self.yaw0 + yaw
+        rate = np.zeros((n, 3))
+        rate[:, 2] = yaw_rate
+        lat, lon, h = _fixed_position(self, n)
+        zeros = np.zeros((n, 3))
+        return MotionState(lat, lon, h, zeros, zeros.copy(), euler, rate)
+
+    def euler_accel(self, t, t_lo=None):
+        """Second derivative of the Euler angles [rad/s^2], (N, 3)."""
+        t, t_lo = as_times(t, t_lo)
+        acc = np.zeros((t.shape[0], 3))
+        acc[:, 2] = self._yaw(t, t_lo, accel=True)[0]
+        return acc
+
+
 # ---------------------------------------------------------------------------
 # 3. Under way
 # ---------------------------------------------------------------------------
