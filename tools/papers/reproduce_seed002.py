@@ -244,7 +244,7 @@ def write_report_from_json(out_dir):
 def write_report(out_dir, table, why, hours):
     with open(os.path.join(out_dir, "report.md"), "w") as fh:
         fh.write(f"# Seed 002 reproduced: no rotation, traditional and flexible two-position, "
-                 f"{hours:g} h\n\n{chr(10).join(__doc__.split(chr(10) * 2)[2:]).strip()}\n\n"
+                 f"{hours:g} h\n\n{(chr(10) * 2).join(__doc__.split(chr(10) * 2)[2:]).strip()}\n\n"
                  f"Table 1's heading read as {CONVENTIONS[CONVENTION['name']][0]} (--convention "
                  f"{CONVENTION['name']}).\n\n![positions](positions.png)\n\n{table}\n{why}")
 

@@ -231,7 +231,7 @@ def main(argv=None):
         fh.write(table + "\n")
     with open(os.path.join(args.out, "report.md"), "w") as fh:
         fh.write(f"# Seed 003 reproduced: single-position rotation vs none, {args.hours:g} h static\n\n"
-                 f"{chr(10).join(__doc__.split(chr(10) * 2)[2:]).strip()}\n\n![errors](errors.png)\n\n{table}\n{explain}")
+                 f"{(chr(10) * 2).join(__doc__.split(chr(10) * 2)[2:]).strip()}\n\n![errors](errors.png)\n\n{table}\n{explain}")
     with open(os.path.join(args.out, "seed003.json"), "w") as fh:
         json.dump(fig_json, fh, indent=2)
     print(explain)
