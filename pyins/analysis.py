@@ -68,7 +68,6 @@ def reduced_truth(limits, phi_true=np.zeros(3)):
     return np.concatenate([phi_hat, eps_hat])
 
 
-
 def swing_cubic(radius, period, swing, window, phases=72, points=400):
     """The largest t^3 coefficient [m/s^3] a swing at anchor puts into a
     window of ``window`` seconds, over the swing's phase at the window's
@@ -85,12 +84,11 @@ def swing_cubic(radius, period, swing, window, phases=72, points=400):
     t = np.linspace(0.0, window, points)
     basis = np.vander(t / window, 4, increasing=True)
     pinv = np.linalg.pinv(basis)[3] / window ** 3
-    best = 0.0
-    for ph in np.linspace(0.0, 2.0 * np.pi, phases, endpoint=False):
-        theta = swing * np.sin(2.0 * np.pi * t / period + ph)
-        c = pinv @ np.stack([-radius * np.sin(theta), radius * (1.0 - np.cos(theta))], axis=1)
-        best = max(best, float(np.hypot(c[0], c[1])))
-    return best
+    ph = np.linspace(0.0, 2.0 * np.pi, phases, endpoint=False)
+    theta = swing * np.sin(2.0 * np.pi * t / period + ph[:, None])      # (phases, points)
+    c_e = (-radius * np.sin(theta)) @ pinv
+    c_n = (radius * (1.0 - np.cos(theta))) @ pinv
+    return float(np.max(np.hypot(c_e, c_n)))
 
 
 def site_accel_for_swing(radius, period, swing, longest=None):
@@ -115,6 +113,7 @@ def site_accel_for_swing(radius, period, swing, longest=None):
     longest = 3.0 * period if longest is None else float(longest)
     windows = np.geomspace(10.0, longest, 120)
     return max(swing_cubic(radius, period, swing, w) * np.sqrt(3.0 * w ** 3) for w in windows)
+
 
 # ---------------------------------------------------------------------------
 # Linear error model of a static INS (an error-budget tool)
