@@ -37,7 +37,7 @@ import time
 
 import numpy as np
 
-from pyins import campaign, scenario
+from pyins import campaign, records, scenario
 from pyins.units import NMI_TO_M
 
 CAMPAIGNS = {"seed002": "seed002_montecarlo", "seed003": "seed003_montecarlo"}
@@ -538,6 +538,16 @@ def _fmt_joint(j, labels):
     return out
 
 
+def _cached(path, compute):
+    """The JSON at ``path``, else ``compute()`` written there (the runs a report needs once)."""
+    if os.path.exists(path):
+        with open(path) as f:
+            return json.load(f)
+    value = compute()
+    records.write_atomic(path, json.dumps(value))
+    return value
+
+
 def report(keys, out_root, report_dir):
     """Write montecarlo.json and the histograms into ``report_dir``; returns the tables as Markdown."""
     os.makedirs(report_dir, exist_ok=True)
@@ -559,22 +569,10 @@ def report(keys, out_root, report_dir):
                *_fmt_rows(stats["rows"], key), "", *_fmt_pairs(stats["pairs"], stats["labels"]), ""]
         if key == "seed002":
             vec = draw_vectors(load(key), out)
-            cache = os.path.join(out, f"up_gyro_response_{CONVENTION['name']}.json")
-            if os.path.exists(cache):
-                with open(cache) as f:
-                    up = json.load(f)
-            else:
-                up = up_gyro_response(CONVENTION["name"])
-                with open(cache, "w") as f:
-                    json.dump(up, f)
-            cache = os.path.join(out, f"paper_set_{CONVENTION['name']}.json")
-            if os.path.exists(cache):
-                with open(cache) as f:
-                    ps = json.load(f)
-            else:
-                ps = paper_set_finals(CONVENTION["name"])
-                with open(cache, "w") as f:
-                    json.dump(ps, f)
+            up = _cached(os.path.join(out, f"up_gyro_response_{CONVENTION['name']}.json"),
+                         lambda: up_gyro_response(CONVENTION["name"]))
+            ps = _cached(os.path.join(out, f"paper_set_{CONVENTION['name']}.json"),
+                         lambda: paper_set_finals(CONVENTION["name"]))
             j = joint(vec, paper_figures(key), up, ps)
             blob[key]["joint"] = j
             with open(os.path.join(report_dir, "montecarlo_draws.json"), "w") as f:
