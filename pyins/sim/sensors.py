@@ -327,7 +327,14 @@ def random_constant_values(name, draw):
     is non-zero in the preset is drawn independently as N(0, sigma^2) with
     sigma = |preset value| (signs and magnitudes both random); terms the
     preset leaves zero stay zero (e.g. seed 002's upper-triangle
-    accelerometer installation terms, every diagonal). The noise terms
+    accelerometer installation terms, every diagonal). A preset whose two
+    installation matrices are one and the same skew-symmetric matrix (seed
+    003 prints [0, -2", 2"; 2", 0, -2"; -2", 2", 0] for both triads) states
+    a common rotation phi of the whole IMU, M = [phi x]: that rotation is
+    drawn instead, phi_i ~ N(0, sigma_i^2) with sigma_i the printed element
+    (`_common_rotation`), and both triads get the same [phi x], so a drawn
+    unit's triads stay orthogonal and consistent with each other, as the
+    paper's. The noise terms
     (ARW, VRW, quantum) are not random constants and stay the preset's; their
     random stream is the scenario's ``seed``.
 
@@ -344,7 +351,26 @@ def random_constant_values(name, draw):
         n = sigma.size
         out[term] = (sigma * z[i:i + n].reshape(sigma.shape), unit)
         i += n
+    common = _common_rotation(p)
+    if common is not None:
+        # phi from the gyro installation terms' normals at the places [phi x]
+        # holds +phi_x, +phi_y, +phi_z: (2, 1), (0, 2), (1, 0)
+        zg = z[6:15].reshape(3, 3)
+        phi = common * np.array([zg[2, 1], zg[0, 2], zg[1, 0]])
+        skew = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
+        out["gyro_misalignment"] = (skew, "arcsec")
+        out["accel_misalignment"] = (skew.copy(), "arcsec")
     return out
+
+
+def _common_rotation(p):
+    """The 1-sigma rotation [arcsec] (x, y, z) when preset ``p`` states its
+    installation errors as one common rotation of both triads (the two
+    matrices equal, skew-symmetric and not zero), else None."""
+    g, a = p.gyro_misalignment, p.accel_misalignment
+    if not np.any(g) or not np.array_equal(g, a) or not np.array_equal(g, -g.T):
+        return None
+    return _sigma_in_unit(np.array([g[2, 1], g[0, 2], g[1, 0]]), ARCSEC_TO_RAD)
 
 
 def random_constant_overrides(name, draw):

@@ -52,6 +52,27 @@ def test_draws_are_zero_mean_with_the_preset_sigma(name):
         assert np.all((s[:, ~zero] > 0).mean(axis=0) > 0.45), f"{term}: both signs are drawn"
 
 
+def test_seed003_draws_one_common_rotation_of_both_triads():
+    """Seed 003 prints one skew-symmetric installation matrix for both
+    triads (a common rotation of the IMU, [phi x] with phi = (2", 2", 2")):
+    a draw is one rotation, phi_i = 2" z_i from the gyro terms' normals at
+    (2, 1), (0, 2), (1, 0), and both triads get the same [phi x] (exactly:
+    a drawn unit's triads stay orthogonal and agree with each other). Seed
+    002's matrices (all six gyro terms, three accelerometer terms) are not
+    one rotation, and stay drawn term by term."""
+    for d in (0, 1, 5):
+        v = sensors.random_constant_values("seed003", d)
+        g, a = v["gyro_misalignment"][0], v["accel_misalignment"][0]
+        assert np.array_equal(g, a)
+        assert np.array_equal(g, -g.T)
+        z = sensors.random_constant_normals(d)[6:15].reshape(3, 3)
+        phi = np.array([g[2, 1], g[0, 2], g[1, 0]])
+        np.testing.assert_allclose(phi, 2.0 * np.array([z[2, 1], z[0, 2], z[1, 0]]), rtol=1e-15, atol=0)
+    v2 = sensors.random_constant_values("seed002", 0)
+    assert not np.array_equal(v2["gyro_misalignment"][0], -v2["gyro_misalignment"][0].T)
+    assert np.count_nonzero(v2["accel_misalignment"][0]) == 3
+
+
 def test_a_draw_is_reproducible_and_its_stream_fixed():
     """Draw 0 of seed002 is pinned (a change of the salt, order or generator
     changes every Monte-Carlo run and its digest); the up gyro of draw 0 is
@@ -222,3 +243,16 @@ def test_statistics_pair_the_draws():
     assert flex["paper"] == pytest.approx(2.97, abs=1e-9) and flex["paper_percentile"] == 30.0
     trad = next(r for r in st["rows"] if r["scheme"] == "two_position" and r["metric"] == "horizontal_error_final")
     assert trad["n"] == 11 and trad["paper"] == pytest.approx(3.70, abs=1e-9)
+
+
+def test_one_seeds_report_keeps_the_others_figures(tmp_path):
+    """`montecarlo.py seed003` alone rewrites montecarlo.json: seed 002's
+    figures already there are kept, not dropped (they took an hour of runs)."""
+    mc = _driver()
+    report_dir = tmp_path / "report"
+    report_dir.mkdir()
+    kept = {"seed002": {"draws": 100, "rows": [{"median": 3.99}]}}
+    (report_dir / "montecarlo.json").write_text(json.dumps(kept))
+    text = mc.report(["seed003"], str(tmp_path / "runs"), str(report_dir))
+    assert "seed003: no complete run" in text
+    assert json.loads((report_dir / "montecarlo.json").read_text()) == kept

@@ -551,7 +551,14 @@ def _cached(path, compute):
 def report(keys, out_root, report_dir):
     """Write montecarlo.json and the histograms into ``report_dir``; returns the tables as Markdown."""
     os.makedirs(report_dir, exist_ok=True)
+    # one seed's report keeps the other's figures in montecarlo.json (and its
+    # tables in montecarlo.md, which `_fill_markdown` rewrites only for both)
     blob, md = {}, []
+    try:
+        with open(os.path.join(report_dir, "montecarlo.json")) as f:
+            blob = {k: v for k, v in json.load(f).items() if k in CAMPAIGNS and k not in keys}
+    except (OSError, ValueError):
+        pass
     for key in keys:
         out = os.path.join(out_root, key)
         result = collect(load(key), out)
@@ -581,8 +588,8 @@ def report(keys, out_root, report_dir):
             md += ["#### The paper's six figures at once, and the schemes beside the shared up-gyro floor", "",
                    *_fmt_joint(j, stats["labels"]), ""]
         md += [timing_line(key, out, result["runs_timing"]), ""]
-    with open(os.path.join(report_dir, "montecarlo.json"), "w") as f:
-        json.dump(blob, f, indent=1, allow_nan=True)
+    blob = {k: blob[k] for k in CAMPAIGNS if k in blob}
+    records.write_atomic(os.path.join(report_dir, "montecarlo.json"), json.dumps(blob, indent=1, allow_nan=True))
     text = "\n".join(md)
     _fill_markdown(os.path.join(report_dir, "montecarlo.md"), keys, text)
     return text
