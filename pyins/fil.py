@@ -49,6 +49,12 @@ __all__ = ["run_fil"]
 
 #: Ticks of normals drawn at a time into the noise's scratch buffer (2.4 MB).
 NOISE_BLOCK = 50_000
+#: Ticks per chunk (run_fil's default): the noise of two chunks is held
+#: (this one's and the next's, drawn ahead), 4 x 3 doubles a tick: 9.6 MB at
+#: 100,000 ticks (48 MB at 500,000, which took a 72 h run to 111 MiB peak
+#: with 60-s records against 75 MiB). The records do not depend on it, bit
+#: for bit (tests/physics/test_fil.py).
+CHUNK_TICKS = 100_000
 
 
 class _Loop:
@@ -158,7 +164,7 @@ def _joined(outs, recs):
 
 
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
-            chunk_ticks=500_000, dt=DT, nodes=5, progress=None, record_dir=None,
+            chunk_ticks=CHUNK_TICKS, dt=DT, nodes=5, progress=None, record_dir=None,
             checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None):
     """Run the closed loop for ``duration_ticks``.
 

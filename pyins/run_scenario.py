@@ -139,7 +139,7 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
                 checkpoint = int(round(CHECKPOINT_S / spec.dt))
                 bar = progress(spec.label) if progress else None
                 run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
-                    checkpoint_ticks=checkpoint, chunk_ticks=min(500_000, checkpoint), progress=bar)
+                    checkpoint_ticks=checkpoint, chunk_ticks=min(fil.CHUNK_TICKS, checkpoint), progress=bar)
                 with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
                     res, info = load_variant(run_dir, spec)
                     mm = metrics.run_metrics(spec, res) if res is not None else {}

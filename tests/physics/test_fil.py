@@ -62,6 +62,18 @@ def test_records_streamed_to_disk_equal_in_memory(tmp_path):
     assert c.outputs.tobytes() == a.outputs.tobytes()
 
 
+def test_chunk_size_does_not_change_a_noisy_run():
+    """The noise is drawn block by block (fil.NOISE_BLOCK) from one stream,
+    so a run with noise gives the same bits whatever its chunks: the old
+    default 500,000, fil.CHUNK_TICKS, and a size that is no multiple of the
+    block (the chunk size is a memory setting only)."""
+    m = sim.HeadingSwing.experiment(1)
+    runs = [fil.run_fil(m, 260_003, config=dict(index_scheme=4), errors=sim.preset("seed002"), seed=3,
+                        every=997, chunk_ticks=ck).outputs.tobytes()
+            for ck in (500_000, fil.CHUNK_TICKS, 65_537)]
+    assert runs[0] == runs[1] == runs[2]
+
+
 def test_text_progress_draws_on_a_terminal():
     import io
 
