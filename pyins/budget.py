@@ -44,7 +44,7 @@ import numpy as np
 
 from pyins import fil, metrics
 from pyins.analysis import StaticErrors, noise_covariance, propagate_errors, table_history, table_nodes
-from pyins.reference import attitude, earth
+from pyins.reference import abi, attitude, earth
 from pyins.scenario.build import initial_truth
 from pyins.sim.imu import body_rate_and_force
 from pyins.sim.sensors import SensorErrors
@@ -67,6 +67,42 @@ def split_errors(errors, sources=SOURCES):
         if np.any(value != 0.0):
             out[name] = SensorErrors(**{name: value})
     return out
+
+
+def element_sources(errors, sources=SOURCES):
+    """{name: a SensorErrors holding one element of ``errors`` alone} for
+    every non-zero element of its deterministic sources, named
+    "gyro_bias[2]", "gyro_misalignment[1,0]", ...: a basis in which every
+    SensorErrors with the same non-zero pattern (every draw of a preset,
+    `pyins.sim.sensors.random_constant_values`) is a linear combination, the
+    model being linear in each element (`element_coefficients`)."""
+    out = {}
+    for name in sources:
+        value = np.array(getattr(errors, name), dtype=float)
+        for idx in zip(*np.nonzero(value)):
+            one = np.zeros_like(value)
+            one[idx] = value[idx]
+            out[f"{name}[{','.join(str(int(i)) for i in idx)}]"] = SensorErrors(**{name: one})
+    return out
+
+
+def element_coefficients(basis, errors):
+    """The coefficients of ``errors`` (a SensorErrors) in ``basis``
+    (`element_sources`), in the basis's order: each element of ``errors``
+    divided by the basis's. An element of ``errors`` that is non-zero where
+    the basis has none raises ValueError (the model would leave it out)."""
+    coef, covered = [], {}
+    for key, e in basis.items():
+        name = key.split("[", 1)[0]
+        idx = tuple(int(i) for i in key[len(name) + 1:-1].split(","))
+        coef.append(float(np.asarray(getattr(errors, name))[idx]) / float(np.asarray(getattr(e, name))[idx]))
+        covered.setdefault(name, set()).add(idx)
+    for name in SOURCES:
+        value = np.asarray(getattr(errors, name))
+        for idx in zip(*np.nonzero(value)):
+            if tuple(int(i) for i in idx) not in covered.get(name, ()):
+                raise ValueError(f"{name}{list(idx)} is non-zero but not in the basis")
+    return np.array(coef)
 
 
 def initial_state_errors(motion, config):
@@ -397,6 +433,35 @@ def _row(source, model, nav=None, check=None):
     return row
 
 
+#: The ship profiles the model holds for: at a fixed position (pyins.sim).
+_FIXED_MOTIONS = ("Static", "Swing", "HeadingSwing", "NarrowbandYaw")
+
+
+def outside_model(spec):
+    """Why the linear model cannot stand for a scenario's run (a
+    pyins.scenario.RunSpec), or None when it can: it navigates from t = 0
+    (no alignment phase), unaided and undamped (no external reference, no
+    damping or integrated mode), with the vertical channel held, on a ship
+    at a fixed position."""
+    cfg = spec.config
+    if cfg.get("coarse_ticks") or cfg.get("fine_ticks"):
+        return ("the error budget's linear model navigates from t = 0: the scenario's "
+                "firmware.coarse_time and firmware.fine_time must be 0 (no alignment phase)")
+    if cfg.get("vertical_mode", 0) != 0:
+        return ("the error budget's linear model holds the vertical channel: the scenario's "
+                "firmware.vertical_mode must be \"hold\"")
+    if getattr(spec, "refs", None) is not None and len(spec.refs):
+        return ("the error budget's linear model is of unaided navigation: the scenario has external "
+                "references ([references]); damping and the integrated filter are outside it")
+    if cfg.get("nav_mode") not in (None, abi.PYINS_NAV_UNDAMPED, abi.PYINS_NAV_AUTO):
+        return ("the error budget's linear model is of undamped navigation: the scenario's "
+                "firmware.nav_mode must be \"undamped\" (or \"auto\" without references)")
+    if type(spec.motion).__name__ not in _FIXED_MOTIONS:
+        return (f"the error budget's linear model is of a ship at a fixed position; the scenario's "
+                f"motion is a {type(spec.motion).__name__} (a moving base is outside it)")
+    return None
+
+
 def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=None, phase=None, on_row=None):
     """The error budget of a scenario's run (a pyins.scenario.RunSpec),
     optionally checked against the firmware one source at a time.
@@ -419,12 +484,9 @@ def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=N
     after the sources).
     """
     cfg = dict(spec.config)
-    if cfg.get("coarse_ticks") or cfg.get("fine_ticks"):
-        raise ValueError("the error budget's linear model navigates from t = 0: the scenario's "
-                         "firmware.coarse_time and firmware.fine_time must be 0 (no alignment phase)")
-    if cfg.get("vertical_mode", 0) != 0:
-        raise ValueError("the error budget's linear model holds the vertical channel: the scenario's "
-                         "firmware.vertical_mode must be \"hold\"")
+    refusal = outside_model(spec)
+    if refusal is not None:
+        raise ValueError(refusal)
     n = duration_ticks or spec.duration_ticks
     shortest = 2 * keep_every * max(1, spec.every or 1)   # the model keeps every keep_every-th record
     if n < shortest:

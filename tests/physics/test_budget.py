@@ -4,11 +4,12 @@ attitude history (pyins.budget.error_budget), each source against a run of
 the firmware with that error alone, the misalignment-times-tilt case among
 them; the noise's 1 sigma against Monte Carlo runs; `pyins budget`."""
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from pyins import analysis, fil, metrics, scenario, sim
+from pyins import analysis, contract, fil, metrics, scenario, sim
 from pyins.budget import (INITIAL, NOISE, SOURCES, budget_verdict, compare_with_run, error_budget, error_drive,
                           run_budget)
 from pyins.reference import attitude, earth
@@ -165,3 +166,52 @@ def test_noise_sigma_matches_monte_carlo():
     print(f"chi2({2 * n}) = {total:.1f}, 99 % bounds [{lo:.1f}, {hi:.1f}]")
     assert lo <= total <= hi
     assert not lo <= total / 4 <= hi and not lo <= total * 4 <= hi
+
+
+@pytest.mark.parametrize("preset", ["seed002", "seed003"])
+def test_a_draw_is_the_sum_of_its_elements(preset):
+    """The budget's Monte Carlo (tools/papers/budget_montecarlo.py) places a
+    draw as the element responses times its coefficients: the basis times
+    the coefficients gives the drawn errors back (to one rounding), and on a
+    2 h run the budget of the draw itself equals the combination of the
+    element budgets (the model is linear in each element) to 1e-9 of its
+    size; an element outside the basis is refused."""
+    from pyins.budget import element_coefficients, element_sources
+    basis = element_sources(sim.sensors.PRESETS[preset])
+    for d in (0, 3):
+        drawn = sim.sensors.draw_random_constants(preset, d)
+        c = element_coefficients(basis, drawn)
+        for name in SOURCES:
+            rebuilt = sum(ci * getattr(e, name) for ci, e in zip(c, basis.values()))
+            np.testing.assert_allclose(rebuilt, getattr(drawn, name), rtol=1e-15, atol=1e-30, err_msg=name)
+    spec = _spec("seed002_exp1", 2, {"indexing.scheme": "flexible", "record_every": "1 s"})
+    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=sim.SensorErrors(),
+                      table=spec.table, every=spec.every)
+    whole = error_budget(spec.motion, res, sim.sensors.draw_random_constants(preset, 3), spec.config,
+                         keep_every=10)
+    parts = error_budget(spec.motion, res, basis, spec.config, keep_every=10)
+    c = element_coefficients(basis, sim.sensors.draw_random_constants(preset, 3))
+    x_whole = whole.states.sum(axis=0)
+    x_parts = np.tensordot(c, parts.states[:len(basis)], axes=1) + parts.states[len(basis)]
+    assert parts.names[-1] == INITIAL and whole.names[-1] == INITIAL
+    assert np.abs(x_parts - x_whole).max() <= 1e-9 * np.abs(x_whole).max()
+    with pytest.raises(ValueError, match="not in the basis"):
+        element_coefficients(element_sources(sim.SensorErrors(gyro_bias=np.array([1e-9, 0.0, 0.0]))),
+                             sim.SensorErrors(gyro_bias=np.array([1e-9, 1e-9, 0.0])))
+
+
+def test_the_model_refuses_what_it_does_not_model():
+    """outside_model names the reason for an alignment phase, a free
+    vertical channel, external references, a damped or integrated mode and
+    a moving ship; a fixed ship navigating unaided passes."""
+    from pyins.budget import outside_model
+    assert outside_model(_spec("seed002_exp1", 1)) is None
+    cases = {"alignment phase": {"firmware.coarse_time": "60 s"},
+             "vertical channel": {"firmware.vertical_mode": "free"},
+             "undamped navigation": {"firmware.nav_mode": "damped"}}
+    for words, over in cases.items():
+        assert words in outside_model(_spec("seed002_exp1", 1, over)), words
+    spec = _spec("seed002_exp1", 1)
+    assert "fixed position" in outside_model(replace(spec, motion=sim.default_voyage()))
+    refs = np.zeros(1, dtype=contract.REF_DTYPE)
+    assert "external" in outside_model(replace(spec, refs=refs))
