@@ -32,6 +32,13 @@ def add_campaign(cmd):
     p.add_argument("--workers", type=int, help="local processes (default: every core)")
     p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", help="campaign directory (default runs/campaigns/NAME)")
+    p.add_argument("--budget", type=int, metavar="N",
+                   help="place N draws of the campaign's random constants through the error budget "
+                        "(one closed-loop run per grid point) instead of a closed-loop run per draw; "
+                        "writes OUT/budget.md and budget.json")
+    p.add_argument("--checks", type=int, metavar="M",
+                   help="with --budget: M closed-loop runs of (grid point, draw) picked at random, "
+                        "held against the budget (default 10)")
 
 
 def add_budget(cmd):
@@ -89,6 +96,15 @@ def _headline(result):
 
 
 def cmd_campaign(args):
+    if args.checks is not None and args.budget is None:
+        raise InputError("--checks is for --budget (the closed-loop checks of the budget's draws)")
+    if args.budget is not None:
+        if args.budget < 1:
+            raise InputError(f"--budget {args.budget}: the number of draws must be 1 or more")
+        if args.checks is not None and args.checks < 0:
+            raise InputError(f"--checks {args.checks}: must be 0 or more")
+        if args.scheduler:
+            raise InputError("--budget runs on the local pool (--workers), not on --scheduler")
     if args.campaign and (args.grid or args.scenario):
         raise InputError("campaign: give a campaign (NAME or FILE) or --scenario with --grid, not both")
     if args.workers is not None and args.workers < 1:
@@ -105,6 +121,8 @@ def cmd_campaign(args):
     except scenario.ScenarioError as exc:
         raise _campaign_option_error(exc, args) from None
     out = args.out or campaign.default_out_dir(camp)
+    if args.budget is not None:
+        return _campaign_by_budget(args, camp, out)
     n_runs = len({p.digest for p in camp.points})
     given = [f"{o} {v}" for o, v in (("--seeds", args.seeds), ("--group-by", group_by))
              if v is not None and args.campaign]
@@ -143,6 +161,74 @@ def cmd_campaign(args):
         say(args, line)
     say(args, f"  aggregates: {os.path.join(out, 'aggregate.md')}")
     emit_json(args, result)
+    return EXIT_OK
+
+
+def _campaign_by_budget(args, camp, out):
+    """`pyins campaign --budget N`: the draws through the error budget
+    (`pyins.campaign.by_budget`), OUT/budget.json and budget.md."""
+    import json
+
+    import numpy as np
+
+    from pyins import records
+    from pyins.campaign.by_budget import by_budget
+    checks = 10 if args.checks is None else args.checks
+    if not camp.random_constants:
+        raise InputError(f"campaign --budget: campaign {camp.name!r} draws no random constants "
+                         f"(campaign.random_constants): the budget has nothing to place")
+    say(args, f"pyins campaign {camp.name} --budget {args.budget} -> {out}: {args.budget:,} draws through the "
+              f"error budget, {checks} closed-loop check(s)")
+    try:
+        res = by_budget(camp, args.budget, checks, args.workers, log=lambda text: say(args, text))
+    except ValueError as exc:
+        raise InputError(f"campaign --budget: {exc}") from None
+    warnings = []
+    if not res["checks"]:
+        warnings.append("no closed-loop check: the budget's figures are not held to the firmware in this run")
+    bad = [c for c in res["checks"] if abs(c["rel"]) > 0.01]
+    if bad:
+        warnings.append(f"{len(bad)} of {len(res['checks'])} check(s) differ from the closed loop by more than "
+                        f"1 % (largest {100 * max(abs(c['rel']) for c in bad):.2f} %): the budget is an "
+                        f"approximation there (a table steered by the unit's own heading)")
+    lines = [f"# {camp.name}: {args.budget:,} draws through the error budget", "",
+             f"Final horizontal error; the budget's draws with the noise drawn from its covariance "
+             f"(`pyins.campaign.by_budget`). {res['seconds_budget']:.0f} s for the budget, "
+             f"{res['seconds_checks']:.0f} s for {len(res['checks'])} closed-loop check(s), "
+             f"{res['workers']} worker(s).", "",
+             "| grid point | draws | median | 5 % | 95 % | checks | largest abs(difference) |", "|---|---|---|---|---|---|---|"]
+    points = []
+    for i, pt in enumerate(res["points"]):
+        v = pt["final_m"]
+        mine = [c for c in res["checks"] if c["point"] == i]
+        worst = max((abs(c["rel"]) for c in mine), default=None)
+        label = ", ".join(f"{k}={x}" for k, x in pt["values"].items())
+        lines.append(f"| {label} | {pt['draws']} | {np.median(v) / NMI_TO_M:.3f} nmi | "
+                     f"{np.percentile(v, 5) / NMI_TO_M:.3f} | {np.percentile(v, 95) / NMI_TO_M:.3f} | "
+                     f"{len(mine)} | {'' if worst is None else f'{100 * worst:.2f} %'} |")
+        say(args, f"  {label}: median {np.median(v) / NMI_TO_M:.3f} nmi (5-95 %: {np.percentile(v, 5) / NMI_TO_M:.3f}"
+                  f"-{np.percentile(v, 95) / NMI_TO_M:.3f}) over {pt['draws']:,} draws")
+        points.append({"values": pt["values"], "draws": pt["draws"], "median_m": float(np.median(v)),
+                       "p5_m": float(np.percentile(v, 5)), "p95_m": float(np.percentile(v, 95)),
+                       "final_m": [float(x) for x in v]})
+    lines += ["", "| grid point | draw | closed loop (no noise) | budget (no noise) | difference |", "|---|---|---|---|---|"]
+    for c in res["checks"]:
+        label = ", ".join(f"{k}={x}" for k, x in c["values"].items())
+        lines.append(f"| {label} | {c['draw']} | {c['closed_loop_m']:.1f} m | {c['budget_m']:.1f} m | "
+                     f"{100 * c['rel']:+.3f} % |")
+    if warnings:
+        lines += ["", *[f"**Warning:** {w}" for w in warnings]]
+    os.makedirs(out, exist_ok=True)
+    records.write_atomic(os.path.join(out, "budget.md"), "\n".join(lines) + "\n")
+    blob = {"campaign": camp.name, "draws": args.budget, "points": points,
+            "checks": [{k: v for k, v in c.items() if k != "point"} for c in res["checks"]],
+            "seconds_budget": res["seconds_budget"], "seconds_checks": res["seconds_checks"],
+            "workers": res["workers"], "warnings": warnings}
+    records.write_atomic(os.path.join(out, "budget.json"), json.dumps(blob, indent=1))
+    for w in warnings:
+        print(f"pyins campaign: warning: {w}", file=sys.stderr)
+    say(args, f"  report: {os.path.join(out, 'budget.md')}")
+    emit_json(args, blob)
     return EXIT_OK
 
 

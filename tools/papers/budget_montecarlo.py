@@ -41,11 +41,9 @@ Writes budget_montecarlo.md and budget_montecarlo.json into --report (the
 timings of both phases in it).
 """
 import argparse
-import concurrent.futures
 import json
 import os
 import sys
-import time
 
 import numpy as np
 from scipy.stats import ks_2samp
@@ -53,85 +51,8 @@ from scipy.stats import ks_2samp
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__))))
 from montecarlo import collect, load  # noqa: E402
 
-from pyins import budget, fil, metrics  # noqa: E402
-from pyins.sim import sensors  # noqa: E402
+from pyins.campaign.by_budget import by_budget  # noqa: E402
 from pyins.units import NMI_TO_M  # noqa: E402
-
-PRESET = "seed002"
-#: the noise draws' generator: seed (NOISE_SALT, draw), apart from every other stream
-NOISE_SALT = 0xB0D6E7
-
-
-def groups(camp):
-    """[(scheme, period)] in the campaign's order, and {(scheme, period): [points by draw]}."""
-    out = {}
-    for p in camp.points:
-        out.setdefault((p.values["indexing.scheme"], p.values["motion.period"]), []).append(p)
-    return list(out), out
-
-
-def spec_of(camp, point, every=None):
-    """The RunSpec of one campaign point (records every ``every`` instead, if given)."""
-    over = dict(point.overrides)
-    if every is not None:
-        over["record_every"] = every
-    return next(camp.base.with_overrides(over).runs())
-
-
-def group_model(key):
-    """Steps 1 and 2 for one group: (basis names, final states (S, 7) of the
-    basis and the initial errors, final noise covariance (2, 2) of north,
-    east [m^2], position scale, seconds)."""
-    t0 = time.perf_counter()
-    camp = load("seed002")
-    _, pts = groups(camp)
-    spec = spec_of(camp, pts[key][0], every="1 s")
-    refusal = budget.outside_model(spec)
-    if refusal is not None:
-        raise SystemExit(f"{key}: {refusal}")
-    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=sensors.SensorErrors(),
-                      table=spec.table, every=spec.every)
-    basis = budget.element_sources(sensors.PRESETS[PRESET])
-    b = budget.error_budget(spec.motion, res, basis, spec.config, keep_every=10,
-                            noise=(spec.errors.gyro_arw, spec.errors.accel_vrw))
-    final = b.states[:, -1, :]
-    init = final[len(basis)] if b.names[-1] == budget.INITIAL else np.zeros(7)
-    return {"names": list(basis), "final": final[:len(basis)], "initial": init,
-            "noise_cov": b.noise_position_cov()[-1], "scale": b.position_scale(),
-            "seconds": time.perf_counter() - t0}
-
-
-def coefficients(names, draws):
-    """(draws, S): every draw's elements over the basis's."""
-    basis = budget.element_sources(sensors.PRESETS[PRESET])
-    assert list(basis) == names
-    return np.array([budget.element_coefficients(basis, sensors.draw_random_constants(PRESET, d))
-                     for d in range(draws)])
-
-
-def finals(model, coef, noise=True):
-    """Final (north, east) [m] of every draw: the budget's, noise drawn per draw if ``noise``."""
-    x = coef @ model["final"] + model["initial"]
-    kn, ke = model["scale"]
-    ne = np.column_stack([x[:, 5] * kn, x[:, 6] * ke])
-    if noise:
-        chol = np.linalg.cholesky(model["noise_cov"])
-        z = np.array([np.random.default_rng([NOISE_SALT, d]).standard_normal(2) for d in range(len(coef))])
-        ne = ne + z @ chol.T
-    return ne
-
-
-def check_run(args):
-    """One closed-loop check: (key, draw, final horizontal error [m], seconds), no noise."""
-    key, draw = args
-    t0 = time.perf_counter()
-    camp = load("seed002")
-    _, pts = groups(camp)
-    spec = spec_of(camp, pts[key][draw])
-    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config,
-                      errors=budget.deterministic(spec.errors), table=spec.table, every=spec.every)
-    return key, draw, float(metrics.nav_errors(res).horizontal_m[-1]), time.perf_counter() - t0
-
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -145,55 +66,29 @@ def main(argv=None):
     if a.draws < 100 or a.checks < 0 or a.workers < 1:
         ap.error("--draws at least 100, --checks >= 0, --workers >= 1")
     camp = load("seed002")
-    keys, pts = groups(camp)
-    vals, names_ = camp.labels["indexing.scheme"]
-    scheme_label = {v.strip('"'): n for v, n in zip(vals, names_)}
-    labels = {k: f"{scheme_label.get(k[0], k[0])}, {'exp. 1' if k[1] == '120 s' else 'exp. 2'}" for k in keys}
+    vals, names = camp.labels["indexing.scheme"]
+    scheme_label = {v.strip('"'): n for v, n in zip(vals, names)}
 
-    # 1-2. one closed-loop run and the budget per group
-    t0 = time.perf_counter()
-    print(f"budget: {len(keys)} groups, one error-free closed-loop run and {21 + 1} responses each")
-    with concurrent.futures.ProcessPoolExecutor(a.workers) as ex:
-        models = dict(zip(keys, ex.map(group_model, keys)))
-    names = models[keys[0]]["names"]
-    # 3. the draws
-    coef = coefficients(names, a.draws)
-    values = {k: np.hypot(*finals(models[k], coef).T) for k in keys}
-    clean = {k: np.hypot(*finals(models[k], coef, noise=False).T) for k in keys}
-    t_budget = time.perf_counter() - t0
-    print(f"  {a.draws:,} draws x {len(keys)} groups through the budget in {t_budget:.0f} s")
-
-    # the checks
-    rng = np.random.default_rng(2026_12_06)
-    picks = [(keys[int(rng.integers(len(keys)))], int(rng.integers(min(a.draws, len(pts[keys[0]])))))
-             for _ in range(a.checks)]
-    t1 = time.perf_counter()
-    checks = []
-    with concurrent.futures.ProcessPoolExecutor(a.workers) as ex:
-        for key, d, loop, sec in ex.map(check_run, picks):
-            bud = float(clean[key][d])
-            checks.append({"scheme": key[0], "period": key[1], "draw": d, "closed_loop_m": loop,
-                           "budget_m": bud, "rel": (bud - loop) / loop})
-            print(f"  check {len(checks)}/{a.checks}: {labels[key]}, draw {d}: closed loop {loop:.1f} m, "
-                  f"budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)")
-    t_checks = time.perf_counter() - t1
+    def label(values):
+        return f"{scheme_label.get(values['indexing.scheme'], values['indexing.scheme'])}, " \
+               f"{'exp. 1' if values['motion.period'] == '120 s' else 'exp. 2'}"
+    res = by_budget(camp, a.draws, a.checks, a.workers, log=print)
 
     # the closed-loop Monte Carlo on disk, the same draws
     disk = {}
     if os.path.isdir(a.closed_loop):
-        res = collect(camp, a.closed_loop)
-        for p in res["points"]:
+        for p in collect(camp, a.closed_loop)["points"]:
             if p["metrics"]:
                 k = (p["values"]["indexing.scheme"], p["values"]["motion.period"])
                 disk.setdefault(k, {})[p["run"]] = p["metrics"][""]["horizontal_error_final_m"]
-
     rows = []
-    for k in keys:
-        v = values[k] / NMI_TO_M
-        row = {"scheme": k[0], "period": k[1], "label": labels[k], "draws": a.draws,
+    for i, pt in enumerate(res["points"]):
+        k = (pt["values"]["indexing.scheme"], pt["values"]["motion.period"])
+        v = pt["final_m"] / NMI_TO_M
+        row = {"scheme": k[0], "period": k[1], "label": label(pt["values"]), "draws": a.draws,
                "median_nmi": float(np.median(v)), "p5_nmi": float(np.percentile(v, 5)),
-               "p95_nmi": float(np.percentile(v, 95)), "seconds_model": models[k]["seconds"]}
-        mine = [c for c in checks if (c["scheme"], c["period"]) == k]
+               "p95_nmi": float(np.percentile(v, 95)), "seconds_model": pt["seconds_model"]}
+        mine = [c for c in res["checks"] if c["point"] == i]
         if mine:
             rel = np.abs([c["rel"] for c in mine])
             row.update(checks=len(mine), checks_within_1pct=int(np.sum(rel <= 0.01)),
@@ -201,7 +96,7 @@ def main(argv=None):
         if k in disk:
             ds = sorted(disk[k])
             loop = np.array([disk[k][d] for d in ds]) / NMI_TO_M
-            same = values[k][ds] / NMI_TO_M
+            same = pt["final_m"][ds] / NMI_TO_M
             row.update(closed_loop_draws=len(ds), closed_loop_median_nmi=float(np.median(loop)),
                        closed_loop_p5_nmi=float(np.percentile(loop, 5)),
                        closed_loop_p95_nmi=float(np.percentile(loop, 95)),
@@ -210,10 +105,12 @@ def main(argv=None):
                        ks_all_draws_p=float(ks_2samp(v, loop).pvalue),
                        paired_median_abs_diff_nmi=float(np.median(np.abs(same - loop))))
         rows.append(row)
+    checks = [{k: v for k, v in c.items() if k != "point"} | {"label": label(c["values"])} for c in res["checks"]]
     rel_all = np.abs([c["rel"] for c in checks]) if checks else np.array([])
-    out = {"draws": a.draws, "checks": checks, "rows": rows, "seconds_budget": t_budget,
-           "seconds_checks": t_checks, "workers": a.workers,
-           "checks_within_1pct": int(np.sum(rel_all <= 0.01)), "checks_total": len(checks)}
+    out = {"draws": a.draws, "checks": checks, "rows": rows, "seconds_budget": res["seconds_budget"],
+           "seconds_checks": res["seconds_checks"], "workers": a.workers,
+           "checks_within_1pct": int(np.sum(rel_all <= 0.01)), "checks_total": len(checks),
+           "load_1min_at_end": os.getloadavg()[0]}
     os.makedirs(a.report, exist_ok=True)
     with open(os.path.join(a.report, "budget_montecarlo.json"), "w") as f:
         json.dump(out, f, indent=1)

@@ -1,0 +1,168 @@
+"""A campaign's draws placed through the error budget instead of the closed
+loop: thousands of production units for the cost of one closed-loop run per
+grid point, held to the closed loop by a few runs drawn at random.
+
+A campaign with ``random_constants`` (a sensor preset whose random constants
+each seeds entry draws, docs/campaigns.md) spreads its units over the draws
+0 .. seeds - 1, one closed-loop run each. The error budget
+(`pyins.budget`) is linear in every element of the sensor errors, so per
+grid point (a group of the campaign's points that differ only in the draw):
+
+1. one closed-loop run of an error-free unit with the point's initial
+   errors, records every 1 s: the table's history. Where the table follows
+   a fixed schedule (no rotation, the fixed two- and four-position schemes)
+   it is every unit's; where the firmware steers the stops from its own
+   heading (the flexible schemes), a unit's heading error can move a stop,
+   and the checks below measure what that costs;
+2. the budget of that run with one source per non-zero element of the
+   preset (`pyins.budget.element_sources`) and the initial errors, and the
+   covariance the noise (ARW, VRW) drives;
+3. draw d's final (north, east) error: the element responses times draw d's
+   elements over the basis's (`pyins.budget.element_coefficients`), plus
+   the initial errors' response, plus one draw of the noise from its final
+   covariance (a generator seeded with (NOISE_SALT, d)), for any number of
+   draws (beyond the campaign's seeds too: the draws are
+   `pyins.sim.sensors.draw_random_constants`).
+
+The checks: ``checks`` (grid point, draw) pairs picked at random (a fixed
+seed), each run in the closed loop with that draw's constants and no noise,
+against the budget's noise-free value. The figure is the final horizontal
+error; the budget gives no maximum over time with noise (the noise is a
+process, its covariance gives the final spread only).
+
+Refused (ValueError) where the budget's model does not hold
+(`pyins.budget.outside_model`: an alignment phase, external references,
+damping, a free vertical channel, a moving ship) or the campaign draws no
+random constants.
+"""
+import concurrent.futures
+import os
+import time
+
+import numpy as np
+
+from pyins import budget, fil, metrics
+from pyins.sim import sensors
+
+__all__ = ["by_budget", "NOISE_SALT"]
+
+#: The noise draws' generator: seed (NOISE_SALT, draw), apart from every other stream.
+NOISE_SALT = 0xB0D6E7
+#: The seed of the checks' choice of (grid point, draw).
+CHECK_SEED = 20261206
+
+
+def grid_points(camp):
+    """[(values as a sorted tuple, [points by draw])] in the campaign's order."""
+    out = {}
+    for p in camp.points:
+        out.setdefault(tuple(sorted(p.values.items())), []).append(p)
+    return [(k, sorted(v, key=lambda p: p.run)) for k, v in out.items()]
+
+
+def _scenario(camp, point, every=None):
+    over = dict(point.overrides)
+    if every is not None:
+        over["record_every"] = every
+    return camp.base.with_overrides(over)
+
+
+def _model(task):
+    """Steps 1 and 2 for one grid point (a worker's task): the final states."""
+    scn, preset = task
+    t0 = time.perf_counter()
+    (spec,) = list(scn.runs())
+    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config, errors=sensors.SensorErrors(),
+                      table=spec.table, every=spec.every)
+    basis = budget.element_sources(sensors.PRESETS[preset])
+    b = budget.error_budget(spec.motion, res, basis, spec.config, keep_every=10,
+                            noise=(spec.errors.gyro_arw, spec.errors.accel_vrw))
+    final = b.states[:, -1, :]
+    init = final[len(basis)] if b.names[-1] == budget.INITIAL else np.zeros(7)
+    cov = b.noise_position_cov()[-1] if b.noise_cov is not None else np.zeros((2, 2))
+    return {"final": final[:len(basis)], "initial": init, "noise_cov": cov, "scale": b.position_scale(),
+            "seconds": time.perf_counter() - t0}
+
+
+def _check(task):
+    """One closed-loop check (a worker's task): final horizontal error [m] without noise."""
+    scn = task
+    t0 = time.perf_counter()
+    (spec,) = list(scn.runs())
+    res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config,
+                      errors=budget.deterministic(spec.errors), table=spec.table, every=spec.every)
+    return float(metrics.nav_errors(res).horizontal_m[-1]), time.perf_counter() - t0
+
+
+def coefficients(preset, draws):
+    """(draws, S): every draw's elements over the basis of ``preset``."""
+    basis = budget.element_sources(sensors.PRESETS[preset])
+    return np.array([budget.element_coefficients(basis, sensors.draw_random_constants(preset, d))
+                     for d in range(draws)])
+
+
+def final_errors(model, coef, noise=True, first_draw=0):
+    """(draws, 2) final (north, east) [m]: the budget's, with one noise draw each if ``noise``."""
+    x = coef @ model["final"] + model["initial"]
+    kn, ke = model["scale"]
+    ne = np.column_stack([x[:, 5] * kn, x[:, 6] * ke])
+    if noise and np.any(model["noise_cov"]):
+        chol = np.linalg.cholesky(model["noise_cov"])
+        z = np.array([np.random.default_rng([NOISE_SALT, first_draw + d]).standard_normal(2)
+                      for d in range(len(coef))])
+        ne = ne + z @ chol.T
+    return ne
+
+
+def by_budget(camp, draws, checks=0, workers=None, log=None):
+    """Place ``draws`` draws of ``camp``'s random constants through the
+    budget at every grid point, and run ``checks`` closed-loop checks.
+    Returns {"points": [{values, draws, final_m (draws,), final_clean_m,
+    seconds_model}], "checks": [{values, draw, closed_loop_m, budget_m, rel,
+    seconds}], "seconds_budget", "seconds_checks", "workers"}."""
+    preset = camp.random_constants
+    if not preset:
+        raise ValueError(f"campaign {camp.name!r} draws no random constants (campaign.random_constants): "
+                         "the budget has nothing to place")
+    if draws < 1 or checks < 0:
+        raise ValueError(f"draws must be >= 1 and checks >= 0, got {draws} and {checks}")
+    workers = workers or os.cpu_count()
+    say = log or (lambda text: None)
+    pts = grid_points(camp)
+    for values, group in pts:
+        (spec,) = list(_scenario(camp, group[0]).runs())
+        refusal = budget.outside_model(spec)
+        if refusal is not None:
+            raise ValueError(f"{dict(values)}: {refusal}")
+    t0 = time.perf_counter()
+    say(f"the budget: {len(pts)} grid point(s), one error-free closed-loop run and one budget each")
+    tasks = [(_scenario(camp, group[0], every="1 s"), preset) for _, group in pts]
+    with concurrent.futures.ProcessPoolExecutor(min(workers, len(tasks))) as ex:
+        models = list(ex.map(_model, tasks))
+    coef = coefficients(preset, draws)
+    out_points = []
+    for (values, _), model in zip(pts, models):
+        out_points.append({"values": dict(values), "draws": draws,
+                           "final_m": np.hypot(*final_errors(model, coef).T),
+                           "final_clean_m": np.hypot(*final_errors(model, coef, noise=False).T),
+                           "seconds_model": model["seconds"]})
+    t_budget = time.perf_counter() - t0
+    say(f"  {draws:,} draws x {len(pts)} grid point(s) through the budget in {t_budget:.0f} s")
+    rng = np.random.default_rng(CHECK_SEED)
+    picks = []
+    for _ in range(checks):
+        i = int(rng.integers(len(pts)))
+        group = pts[i][1]
+        picks.append((i, group[int(rng.integers(min(draws, len(group))))]))
+    t1 = time.perf_counter()
+    out_checks = []
+    if picks:
+        with concurrent.futures.ProcessPoolExecutor(min(workers, len(picks))) as ex:
+            for (i, p), (loop, sec) in zip(picks, ex.map(_check, [_scenario(camp, p) for _, p in picks])):
+                bud = float(out_points[i]["final_clean_m"][p.run])
+                out_checks.append({"values": dict(pts[i][0]), "point": i, "draw": p.run, "closed_loop_m": loop,
+                                   "budget_m": bud, "rel": (bud - loop) / loop, "seconds": sec})
+                say(f"  check {len(out_checks)}/{len(picks)}: {dict(pts[i][0])}, draw {p.run}: closed loop "
+                    f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)")
+    return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
+            "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset}
