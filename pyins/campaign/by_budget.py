@@ -162,7 +162,9 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
                 bud = float(out_points[i]["final_clean_m"][p.run])
                 out_checks.append({"values": dict(pts[i][0]), "point": i, "draw": p.run, "closed_loop_m": loop,
                                    "budget_m": bud, "rel": (bud - loop) / loop, "seconds": sec})
+                left = (time.perf_counter() - t1) / len(out_checks) * (len(picks) - len(out_checks))
                 say(f"  check {len(out_checks)}/{len(picks)}: {dict(pts[i][0])}, draw {p.run}: closed loop "
-                    f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)")
+                    f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)"
+                    + (f"; about {left:.0f} s left" if len(out_checks) < len(picks) else ""))
     return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
             "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset}
