@@ -25,6 +25,14 @@ seed 002's sensor errors, noise seeded per run).
    (its helper thread, its memory traffic: the CPU time per run grows with
    two at once) or on the machine.
 
+4. (``--dask``) the campaign engine itself (`pyins.campaign.run_campaign`:
+   a pool of workers that keep the libraries loaded) on --runs draws of
+   seed 002 exp. 1 (flexible scheme, --dask-hours each): the local pool
+   with one and two workers, and a Dask LocalCluster of one and two
+   worker processes; runs per second of each, and the scheduler's cost per
+   run (Dask's wall time less the local pool's of the same width, over the
+   runs).
+
 It prints and never asserts: the figures are for a person; docs/benchmarks.md
 keeps them with their conditions (load, commit).
 """
@@ -101,12 +109,52 @@ def batch(jobs, width):
     return time.perf_counter() - t0, done
 
 
+def engine_section(a, work):
+    """Section 4: the campaign engine, local pool and Dask LocalCluster, one and two workers."""
+    from distributed import LocalCluster
+
+    from pyins import campaign
+    camp = campaign.from_args("seed002_exp1", {"indexing.scheme": ["flexible"]}, seeds=a.runs, compare="drop",
+                              random_constants="seed002",
+                              overrides={"duration": f"{a.dask_hours} h", "record_every": "60 s",
+                                         "outputs.plots": False, "outputs.csv": False},
+                              name="bench_campaign")
+    print(f"\n4. the campaign engine: {a.runs} draws of seed 002 exp. 1, flexible, {a.dask_hours:g} h each")
+    rows = {}
+    for kind in ("local", "dask"):
+        for width in (1, 2):
+            out = os.path.join(work, f"engine_{kind}_{width}")
+            t0 = time.perf_counter()
+            if kind == "local":
+                campaign.run_campaign(camp, out, workers=width, plots=False)
+            else:
+                with LocalCluster(n_workers=width, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+                    t0 = time.perf_counter()       # the cluster's start-up is not a run's cost
+                    campaign.run_campaign(camp, out, scheduler=cluster.scheduler_address, plots=False)
+            wall = time.perf_counter() - t0
+            rows[f"{kind}_{width}"] = {"wall_s": wall, "runs_per_s": a.runs / wall}
+            print(f"   {kind:5s} {width} worker{'s' if width > 1 else ' '}: {wall:6.1f} s, "
+                  f"{a.runs / wall:.3f} runs/s")
+    for width in (1, 2):
+        over = (rows[f"dask_{width}"]["wall_s"] - rows[f"local_{width}"]["wall_s"]) / a.runs * width
+        rows[f"dask_overhead_per_run_s_{width}"] = over
+        print(f"   Dask's cost per run with {width} worker{'s' if width > 1 else ''}: {over:+.2f} s")
+    for kind in ("local", "dask"):
+        r = rows[f"{kind}_2"]["runs_per_s"] / rows[f"{kind}_1"]["runs_per_s"]
+        rows[f"{kind}_ratio_two_to_one"] = r
+        print(f"   {kind}: two workers / one {r:.2f}x")
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hours", type=float, default=72.0, help="ship time of a run (default 72 h)")
     ap.add_argument("--runs", type=int, default=4, help="runs for sections 2 and 3 (default 4)")
     ap.add_argument("--json", default=os.path.join("runs", "bench", "campaign.json"))
-    ap.add_argument("--skip-memory", action="store_true", help="only section 3")
+    ap.add_argument("--skip-memory", action="store_true", help="skip sections 1 and 2")
+    ap.add_argument("--dask", action="store_true", help="also section 4 (needs dask, the campaign extra)")
+    ap.add_argument("--dask-hours", type=float, default=12.0, help="ship time of a section-4 run (default 12 h)")
     a = ap.parse_args(argv)
     if a.hours <= 0 or a.runs < 2:
         ap.error("--hours must be > 0 and --runs at least 2")
@@ -150,6 +198,8 @@ def main(argv=None):
     fig.update({"one_worker": rows[1], "two_workers": rows[2], "throughput_ratio": ratio,
                 "ratio_cpu_share_allows": allowed, "cpu_time_growth_two_at_once": growth,
                 "load_1min_after": os.getloadavg()[0]})
+    if a.dask:
+        fig["engine"] = engine_section(a, work)
     os.makedirs(os.path.dirname(os.path.abspath(a.json)), exist_ok=True)
     with open(a.json, "w") as f:
         json.dump(fig, f, indent=2)
