@@ -43,7 +43,9 @@ states: the heading and the tilt each table move exposes; seed 002's gyros:
 nav_level_scale_sigma [ppm] and nav_level_mis_sigma [arcsec] (the level
 gyros' scale factors and misalignments, through which the Earth's rate
 gives a heading error indexing does not remove); ``--bias-rw`` its
-nav_gyro_bias_rw [deg/h/sqrt(h)] (0: the biases random constants).
+nav_gyro_bias_rw [deg/h/sqrt(h)] (0: the biases random constants; the
+acceptance run over 72 h tells it 0.0005, stabilising noise for the terms
+the filter leaves out: docs/concepts.md, "The filter").
 GNSS at 1 Hz: 3 m (5 m up) white, 0.05 m/s; ``--bias`` the receiver's
 Gauss-Markov bias [m] (300 s), which the filter does not model (0: none).
 
