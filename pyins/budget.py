@@ -462,6 +462,19 @@ def outside_model(spec):
     return None
 
 
+def steered_table(spec):
+    """True when the scenario's table stops where the firmware's own heading
+    says (the flexible schemes, heading isolation, a custom cycle with a
+    flexible step): the table's history, which the model takes from one run,
+    then depends on the unit's errors, and a budget driven by another run's
+    history is an approximation (docs/campaigns.md, "Draws through the error
+    budget")."""
+    scheme = spec.config.get("index_scheme", abi.PYINS_INDEX_NONE)
+    if scheme in (abi.PYINS_INDEX_FLEXIBLE_TWO, abi.PYINS_INDEX_FLEXIBLE_DERIVED, abi.PYINS_INDEX_HEADING_ISOLATION):
+        return True
+    return scheme == abi.PYINS_INDEX_CUSTOM and any(step[1] != 1 for step in spec.config.get("index_steps", ()))
+
+
 def run_budget(spec, check=False, duration_ticks=None, keep_every=10, progress=None, phase=None, on_row=None):
     """The error budget of a scenario's run (a pyins.scenario.RunSpec),
     optionally checked against the firmware one source at a time.

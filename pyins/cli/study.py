@@ -186,6 +186,11 @@ def _campaign_by_budget(args, camp, out):
     warnings = []
     if not res["checks"]:
         warnings.append("no closed-loop check: the budget's figures are not held to the firmware in this run")
+    steered = [", ".join(f"{k}={x}" for k, x in pt["values"].items()) for pt in res["points"] if pt["steered"]]
+    if steered:
+        warnings.append(f"the table is steered by the unit's own heading at {len(steered)} grid point(s) "
+                        f"({'; '.join(steered)}): the budget takes every unit's stops from the error-free "
+                        f"unit's, an approximation; the checks measure its error there")
     bad = [c for c in res["checks"] if abs(c["rel"]) > 0.01]
     if bad:
         warnings.append(f"{len(bad)} of {len(res['checks'])} check(s) differ from the closed loop by more than "
@@ -202,13 +207,14 @@ def _campaign_by_budget(args, camp, out):
         v = pt["final_m"]
         mine = [c for c in res["checks"] if c["point"] == i]
         worst = max((abs(c["rel"]) for c in mine), default=None)
-        label = ", ".join(f"{k}={x}" for k, x in pt["values"].items())
+        label = ", ".join(f"{k}={x}" for k, x in pt["values"].items()) + (" (steered)" if pt["steered"] else "")
         lines.append(f"| {label} | {pt['draws']} | {np.median(v) / NMI_TO_M:.3f} nmi | "
                      f"{np.percentile(v, 5) / NMI_TO_M:.3f} | {np.percentile(v, 95) / NMI_TO_M:.3f} | "
                      f"{len(mine)} | {'' if worst is None else f'{100 * worst:.2f} %'} |")
         say(args, f"  {label}: median {np.median(v) / NMI_TO_M:.3f} nmi (5-95 %: {np.percentile(v, 5) / NMI_TO_M:.3f}"
                   f"-{np.percentile(v, 95) / NMI_TO_M:.3f}) over {pt['draws']:,} draws")
-        points.append({"values": pt["values"], "draws": pt["draws"], "median_m": float(np.median(v)),
+        points.append({"values": pt["values"], "draws": pt["draws"], "steered": pt["steered"],
+                       "median_m": float(np.median(v)),
                        "p5_m": float(np.percentile(v, 5)), "p95_m": float(np.percentile(v, 95)),
                        "final_m": [float(x) for x in v]})
     lines += ["", "| grid point | draw | closed loop (no noise) | budget (no noise) | difference |", "|---|---|---|---|---|"]

@@ -326,3 +326,27 @@ def test_campaign_budget_refuses_what_it_cannot_place(tmp_path, capsys):
     f.write_text(BUDGET_CAMPAIGN + '"firmware.coarse_time" = "60 s"\n')
     assert cli.main(["campaign", str(f), "--budget", "10", "--out", str(tmp_path / "o")]) == 2
     assert "alignment phase" in capsys.readouterr().err
+
+
+def test_campaign_budget_warns_where_the_table_is_steered(tmp_path, capsys):
+    """The flexible scheme stops where the unit's own heading says: the
+    budget takes every unit's stops from the error-free unit's, so the grid
+    point is marked steered and the warning is printed and kept in
+    budget.json and budget.md; no check at all is a warning too."""
+    from pyins import __main__ as cli
+    from pyins.budget import steered_table
+    f = tmp_path / "c.toml"
+    f.write_text(BUDGET_CAMPAIGN.replace('scenario = "seed003"', 'scenario = "seed002_exp1"')
+                 .replace('random_constants = "seed003"', 'random_constants = "seed002"')
+                 .replace('["none", "single_position"]', '["two_position", "flexible"]')
+                 .replace('"2 h"', '"1 h"'))
+    out = tmp_path / "out"
+    assert cli.main(["campaign", str(f), "--budget", "20", "--checks", "0", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    res = json.loads((out / "budget.json").read_text())
+    assert [p["steered"] for p in res["points"]] == [False, True]
+    assert any("steered by the unit's own heading" in w for w in res["warnings"])
+    assert any("no closed-loop check" in w for w in res["warnings"])
+    assert "steered by the unit's own heading" in err and "(steered)" in (out / "budget.md").read_text()
+    spec = next(scenario.load("seed003").with_overrides({"compare": None, "paper": None}).runs())
+    assert not steered_table(spec)

@@ -85,7 +85,8 @@ def main(argv=None):
     for i, pt in enumerate(res["points"]):
         k = (pt["values"]["indexing.scheme"], pt["values"]["motion.period"])
         v = pt["final_m"] / NMI_TO_M
-        row = {"scheme": k[0], "period": k[1], "label": label(pt["values"]), "draws": a.draws,
+        row = {"scheme": k[0], "period": k[1], "label": label(pt["values"]) + (" (steered)" if pt["steered"] else ""),
+               "steered": pt["steered"], "draws": a.draws,
                "median_nmi": float(np.median(v)), "p5_nmi": float(np.percentile(v, 5)),
                "p95_nmi": float(np.percentile(v, 95)), "seconds_model": pt["seconds_model"]}
         mine = [c for c in res["checks"] if c["point"] == i]
