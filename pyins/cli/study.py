@@ -1,11 +1,15 @@
 """`pyins campaign` and `pyins budget`: many runs of a scenario (grids,
 Monte Carlo, local or on Dask), and each sensor error's share of one."""
+import json
 import math
 import os
 import sys
 import time
 
-from pyins import budget, campaign, scenario
+import numpy as np
+
+from pyins import budget, campaign, records, scenario
+from pyins.campaign.by_budget import by_budget
 from pyins.metrics import display
 from pyins.units import NMI_TO_M
 
@@ -167,12 +171,6 @@ def cmd_campaign(args):
 def _campaign_by_budget(args, camp, out):
     """`pyins campaign --budget N`: the draws through the error budget
     (`pyins.campaign.by_budget`), OUT/budget.json and budget.md."""
-    import json
-
-    import numpy as np
-
-    from pyins import records
-    from pyins.campaign.by_budget import by_budget
     checks = 10 if args.checks is None else args.checks
     if not camp.random_constants:
         raise InputError(f"campaign --budget: campaign {camp.name!r} draws no random constants "
