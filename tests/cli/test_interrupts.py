@@ -258,8 +258,14 @@ def test_ctrl_c_as_a_finished_run_is_told_counts_it(tmp_path, monkeypatch):
     monkeypatch.setattr(Future, "exception", exception_then_ctrl_c)
     camp = campaign.from_args("seed003", [], 3, overrides={"duration": "0.05 h"})
     out = tmp_path / "c"
-    with pytest.raises(campaign.CampaignInterrupted) as info:
-        campaign.run_campaign(camp, out, workers=2, plots=False)
+    # a Ctrl-C that reaches Python: a shell starts a background job (`cmd &`)
+    # with SIGINT ignored, and the interpreter then never raises it
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(campaign.CampaignInterrupted) as info:
+            campaign.run_campaign(camp, out, workers=2, plots=False)
+    finally:
+        signal.signal(signal.SIGINT, old)
     assert fired
     finished = _finished_runs(out)
     assert len(finished) >= 1 and info.value.result["execution"]["computed"] == len(finished)
