@@ -91,17 +91,18 @@ def element_coefficients(basis, errors):
     (`element_sources`), in the basis's order: each element of ``errors``
     divided by the basis's. An element of ``errors`` that is non-zero where
     the basis has none raises ValueError (the model would leave it out)."""
-    coef, covered = [], {}
-    for key, e in basis.items():
-        name = key.split("[", 1)[0]
-        idx = tuple(int(i) for i in key[len(name) + 1:-1].split(","))
-        coef.append(float(np.asarray(getattr(errors, name))[idx]) / float(np.asarray(getattr(e, name))[idx]))
-        covered.setdefault(name, set()).add(idx)
+    coef = []
+    covered = {name: np.zeros(np.shape(getattr(errors, name)), dtype=bool) for name in SOURCES}
+    for e in basis.values():
+        name = next(n for n in SOURCES if np.any(getattr(e, n)))
+        value = np.asarray(getattr(e, name))
+        idx = tuple(int(i[0]) for i in np.nonzero(value))
+        coef.append(float(np.asarray(getattr(errors, name))[idx]) / float(value[idx]))
+        covered[name][idx] = True
     for name in SOURCES:
-        value = np.asarray(getattr(errors, name))
-        for idx in zip(*np.nonzero(value)):
-            if tuple(int(i) for i in idx) not in covered.get(name, ()):
-                raise ValueError(f"{name}{list(idx)} is non-zero but not in the basis")
+        stray = (np.asarray(getattr(errors, name)) != 0.0) & ~covered[name]
+        if np.any(stray):
+            raise ValueError(f"{name}{[int(i[0]) for i in np.nonzero(stray)]} is non-zero but not in the basis")
     return np.array(coef)
 
 
