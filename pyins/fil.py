@@ -165,7 +165,8 @@ def _joined(outs, recs):
 
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
             chunk_ticks=CHUNK_TICKS, dt=DT, nodes=5, progress=None, record_dir=None,
-            checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None):
+            checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None,
+            keep_result=True):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -179,7 +180,9 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     records are streamed to ``outputs.bin`` and ``plant.bin`` there (raw
     OUTPUT_DTYPE / PLANT_RECORD_DTYPE, described in ``records.json``) chunk
     by chunk and returned memory-mapped, so memory stays bounded for any
-    duration. Returns a FilResult.
+    duration. Returns a FilResult; with a record directory and
+    ``keep_result=False``, None (the records are on disk; the truth beside
+    them is not computed: `pyins.records.score_variant` reads them back).
 
     ``refs`` (REF_DTYPE, sorted by tick; e.g. ``pyins.sim.references.gnss(...)
     .refs``) are external references pushed as they become available, as
@@ -301,6 +304,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         sink.close()
         if loop.done >= duration_ticks and not os.path.exists(os.path.join(record_dir, records.RECORDS)):
             records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
+        if not keep_result:
+            return None
         outputs, plant, _ = load_records(record_dir)
     else:
         outputs = outs[:kept] if outs is not None else np.empty(0, dtype=contract.OUTPUT_DTYPE)

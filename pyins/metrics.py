@@ -32,6 +32,7 @@ Steps of a run's metrics:
 4. the static fine-alignment stage, the filter's drift estimate beside the
    limit at t = 0.
 """
+import math
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Callable
@@ -44,8 +45,8 @@ from pyins.reference.fine_align import EPS, EPS_NU, PHI
 from pyins.units import (ARCMIN_TO_RAD, ARCSEC_TO_RAD, DPH_TO_RPS, NMI_TO_M, TWO_PI, UNITS)
 
 __all__ = ["Metric", "TABLE", "NAMES", "FIGURE_METRICS", "RUN_METRICS", "GROUP_METRICS", "NavErrors",
-           "nav_errors", "run_metrics", "group_metrics", "info", "dimension", "describe", "si_unit",
-           "si_name", "display"]
+           "nav_errors", "run_metrics", "start", "scored", "group_metrics", "aligned", "aligned_at", "info",
+           "dimension", "describe", "si_unit", "si_name", "display"]
 
 
 # ---------------------------------------------------------------------------
@@ -107,42 +108,107 @@ def nav_errors(result):
 
 
 class _Run:
-    """What the run metrics read: the errors of one run and, when a stage
-    needs them, the alignment limits (computed once)."""
+    """What the run metrics read, reduced from a run's records chunk by chunk
+    (`add`), so a run of any length is scored in memory bounded by one chunk:
+    the last record's errors, the maxima over the navigating records and over
+    all of them, the sums of squares over the same two sets, each GNSS
+    outage's largest horizontal error, and the alignment limits (computed
+    once). A maximum is np.maximum's (a NaN anywhere stays NaN, as
+    ndarray.max does); a sum of squares is exact to 2^-106 (math.fsum,
+    carried as its rounded value and remainder), so no figure depends on the
+    chunking."""
 
-    def __init__(self, spec, res):
-        self.spec, self.res = spec, res
-        self.err = nav_errors(res)
-        self.att = self.err.att_n_rad
-        self.level = np.abs(self.att[:, :2]).max(axis=1)
+    _MAXED = ("h", "level", "heading", "vel")
+
+    def __init__(self, spec, end_s):
+        self.spec = spec
+        self.max_all = dict.fromkeys(self._MAXED, -np.inf)
+        self.max_nav = dict.fromkeys(self._MAXED, -np.inf)
+        self.sq_all = {"h": [0.0, 0.0], "heading": [0.0, 0.0]}     # [rounded sum, remainder]
+        self.sq_nav = {"h": [0.0, 0.0], "heading": [0.0, 0.0]}
+        self.n_all = self.n_nav = 0
+        #: each GNSS outage (start, end) [s] (``end_s``: the last record's time) and its
+        #: largest horizontal error so far
+        self.windows = gnss_outages(getattr(spec, "refs", None), spec.dt, end_s)
+        self.window_max = [0.0] * len(self.windows)
+        self.last = None          # the last record's errors, truth and filter state
+
+    def add(self, res):
+        """Fold in the next chunk of records (a records.FilResult, in tick order)."""
+        if len(res.outputs) == 0:
+            return
+        e = nav_errors(res)
+        att = e.att_n_rad
         nav = np.asarray(res.outputs["mode"]) == abi.PYINS_MODE_NAVIGATE
-        #: the firmware navigated (during an alignment it holds the site and zero velocity:
-        #: a position or velocity error then is the ship's own motion, not the INS's)
-        self.navigates = int(np.count_nonzero(nav)) > 1
-        aligns = bool(spec.config.get("coarse_ticks", 0) or spec.config.get("fine_ticks", 0))
-        #: the records the attitude maxima are judged on: from the end of the alignment (the
-        #: unaligned start is not the INS's error); an alignment-only run: its last record
-        self.judged = (nav if nav.any() else np.arange(len(nav)) == len(nav) - 1) if aligns else \
-            np.ones(len(nav), bool)
-        self.nav = nav if nav.any() else np.ones(len(nav), bool)
+        per = {"h": e.horizontal_m, "level": np.abs(att[:, :2]).max(axis=1), "heading": np.abs(att[:, 2]),
+               "vel": np.abs(e.vel_n_mps[:, :2]).max(axis=1)}
+        any_nav = bool(nav.any())
+        for k, x in per.items():
+            self.max_all[k] = np.maximum(self.max_all[k], x.max())
+            if any_nav:
+                self.max_nav[k] = np.maximum(self.max_nav[k], x[nav].max())
+        for k in self.sq_all:
+            sq = per[k] * per[k]
+            _fold(self.sq_all[k], sq)
+            if any_nav:
+                _fold(self.sq_nav[k], sq[nav])
+        self.n_all += len(nav)
+        self.n_nav += int(np.count_nonzero(nav))
+        t = e.time_s
+        for i, (a, b) in enumerate(self.windows):
+            x = e.horizontal_m[(t >= a) & (t <= b)]
+            if len(x):
+                self.window_max[i] = np.maximum(self.window_max[i], x.max())
+        out = res.outputs[-1]
+        self.last = dict(h=e.horizontal_m[-1], att=att[-1].copy(), level=per["level"][-1],
+                         kf_x=np.array(out["kf_x"]), n_ref_rejected=np.array(out["n_ref_rejected"]),
+                         lat=float(res.truth.lat[-1]), euler=np.array(res.truth.euler[-1]))
 
-    @cached_property
+    @property
+    def navigates(self):
+        """The firmware navigated (during an alignment it holds the site and zero
+        velocity: a position or velocity error then is the ship's own motion,
+        not the INS's)."""
+        return self.n_nav > 1
+
+    def over_nav(self, k):
+        """The largest of quantity k over the navigating records (all of them
+        when none navigates)."""
+        return float(self.max_nav[k] if self.n_nav else self.max_all[k])
+
+    def over_judged(self, k):
+        """The largest of attitude quantity k ("level", "heading") over the
+        records the attitude is judged on: from the end of the alignment (the
+        unaligned start is not the INS's error); an alignment-only run: its
+        last record; a run given its attitude: all of them."""
+        aligns = self.spec.config.get("coarse_ticks", 0) or self.spec.config.get("fine_ticks", 0)
+        if not aligns:
+            return float(self.max_all[k])
+        if self.n_nav:
+            return float(self.max_nav[k])
+        return float(self.last["level"] if k == "level" else abs(self.last["att"][2]))
+
+    def rms_nav(self, k):
+        """RMS of quantity k ("h", "heading") over the navigating records (all
+        when none navigates)."""
+        s, n = (self.sq_nav[k], self.n_nav) if self.n_nav else (self.sq_all[k], self.n_all)
+        return float(np.sqrt(s[0] / n))
+
+    @property
     def outage_drifts(self):
         """The largest horizontal error of each GNSS outage (`gnss_outages`) [m]."""
-        t = self.err.time_s
-        return np.array([self.err.horizontal_m[(t >= a) & (t <= b)].max(initial=0.0)
-                         for a, b in gnss_outages(self.spec.refs, self.spec.dt, t[-1])])
+        return np.array(self.window_max, dtype=float)
 
     @cached_property
     def final_limits(self):
         """The alignment limits at the final true attitude (seed 001 eq. 21)."""
-        return analysis.alignment_limits(float(self.res.truth.lat[-1]), self.res.truth.euler[-1],
+        return analysis.alignment_limits(self.last["lat"], self.last["euler"],
                                          self.spec.errors.gyro_bias, self.spec.errors.accel_bias)
 
     @cached_property
     def vs_limit(self):
         """phi at the end minus its limit."""
-        return self.att[-1] - self.final_limits.phi_n
+        return self.last["att"] - self.final_limits.phi_n
 
     @cached_property
     def start_limits(self):
@@ -155,12 +221,22 @@ class _Run:
     def drift_error(self):
         """True minus estimated drift in n at the end [E, N, U] (the 5-state
         filter estimates no eps_E: taken as 0)."""
-        kf_x = self.res.outputs["kf_x"]
+        kf_x = self.last["kf_x"]
         if self.spec.config.get("fine_states", 8) == 5:
-            eps = np.concatenate([[0.0], kf_x[-1, EPS_NU]])
+            eps = np.concatenate([[0.0], kf_x[EPS_NU]])
         else:
-            eps = np.asarray(kf_x[-1, EPS])
+            eps = np.asarray(kf_x[EPS])
         return self.start_limits.eps_n - eps
+
+
+def _fold(acc, x):
+    """acc = [s, r] (a sum carried as its rounded value and remainder) plus
+    the values x, rounded once (math.fsum): the same whatever the chunks."""
+    values = [acc[0], acc[1], *x.tolist()]
+    s = math.fsum(values)
+    values.append(-s)
+    acc[1] = math.fsum(values)
+    acc[0] = s
 
 
 def _std(variants):
@@ -207,38 +283,38 @@ TABLE = (
     _m("horizontal_error_final", "length", "m", _M,
        "horizontal position error at the end of the run (a run that navigates: an alignment holds "
        "the site)",
-       lambda r: float(r.err.horizontal_m[-1]), stage="position"),
+       lambda r: float(r.last["h"]), stage="position"),
     _m("horizontal_error_max", "length", "m", _M,
        "largest horizontal position error while navigating (after the alignment, if any)",
-       lambda r: float(r.err.horizontal_m[r.nav].max()), stage="position"),
+       lambda r: r.over_nav("h"), stage="position"),
     _m("level_error_final", "angle", "arcsec", _ARCSEC,
        "larger of |phi_E|, |phi_N| at the end of the run",
-       lambda r: float(r.level[-1])),
+       lambda r: float(r.last["level"])),
     _m("level_error_max", "angle", "arcsec", _ARCSEC,
        "largest |phi_E|, |phi_N| from the end of the alignment (the whole run when the attitude is "
        "given; an alignment-only run: at its end)",
-       lambda r: float(r.level[r.judged].max())),
+       lambda r: r.over_judged("level")),
     _m("heading_error_final", "angle", "arcmin", _ARCMIN,
        "|phi_U| at the end of the run",
-       lambda r: float(abs(r.att[-1, 2]))),
+       lambda r: float(abs(r.last["att"][2]))),
     _m("heading_error_max", "angle", "arcmin", _ARCMIN,
        "largest |phi_U| from the end of the alignment (the whole run when the attitude is given; an "
        "alignment-only run: at its end)",
-       lambda r: float(np.abs(r.att[r.judged, 2]).max())),
+       lambda r: r.over_judged("heading")),
     _m("velocity_error_max", "velocity", "m/s", 1.0,
        "largest horizontal velocity error component while navigating (after the alignment, if any)",
-       lambda r: float(np.abs(r.err.vel_n_mps[r.nav, :2]).max()), stage="position"),
+       lambda r: r.over_nav("vel"), stage="position"),
     _m("horizontal_error_rms", "length", "m", _M,
        "RMS horizontal position error while navigating (a run with external references: "
        "[references] in its scenario)",
-       lambda r: float(np.sqrt(np.mean(r.err.horizontal_m[r.nav] ** 2))), stage="aided"),
+       lambda r: r.rms_nav("h"), stage="aided"),
     _m("heading_error_rms", "angle", "arcmin", _ARCMIN,
        "RMS |phi_U| while navigating (a run with external references)",
-       lambda r: float(np.sqrt(np.mean(r.att[r.nav, 2] ** 2))), stage="aided"),
+       lambda r: r.rms_nav("heading"), stage="aided"),
     _m("references_rejected", "dimensionless", "", 1.0,
        "references the firmware's innovation gate rejected, all kinds (a run with external "
        "references)",
-       lambda r: float(np.sum(r.res.outputs["n_ref_rejected"][-1])), stage="aided", figure=False),
+       lambda r: float(np.sum(r.last["n_ref_rejected"])), stage="aided", figure=False),
     _m("outage_drift_rms", "length", "m", _M,
        "RMS over the GNSS outages (gaps of more than 2.5 fix intervals in the position fixes) of each "
        "outage's largest horizontal error (KF-GINS's figure: 60-s outages every 180 s)",
@@ -258,22 +334,22 @@ TABLE = (
        lambda r: float(abs(r.vs_limit[2])), stage="alignment"),
     _m("att_east_gap_final", "angle", "arcmin", _ARCMIN,
        "|phi_E error - theoretical limit| at the end (alignment)",
-       lambda r: float(abs(r.att[-1, 0] - r.start_limits.phi_n[0])), stage="static_fine"),
+       lambda r: float(abs(r.last["att"][0] - r.start_limits.phi_n[0])), stage="static_fine"),
     _m("att_up_gap_final", "angle", "arcmin", _ARCMIN,
        "|phi_U error - theoretical limit| at the end (alignment)",
-       lambda r: float(abs(r.att[-1, 2] - r.start_limits.phi_n[2])), stage="static_fine"),
+       lambda r: float(abs(r.last["att"][2] - r.start_limits.phi_n[2])), stage="static_fine"),
     _m("drift_north_gap_final", "angular_rate", "deg/h", DPH_TO_RPS,
        "|eps_N estimate error - limit| at the end (fine alignment)",
        lambda r: float(abs(r.drift_error[1] - r.start_limits.eps_n_limit[1])), stage="static_fine"),
     _m("phi_e_final", "angle", "arcsec", _ARCSEC,
        "phi_E (east attitude error) at the end of the run",
-       lambda r: float(r.att[-1, 0]), figure=False),
+       lambda r: float(r.last["att"][0]), figure=False),
     _m("phi_n_final", "angle", "arcsec", _ARCSEC,
        "phi_N (north attitude error) at the end of the run",
-       lambda r: float(r.att[-1, 1]), figure=False),
+       lambda r: float(r.last["att"][1]), figure=False),
     _m("phi_u_final", "angle", "arcmin", _ARCMIN,
        "phi_U (up attitude error, heading) at the end of the run",
-       lambda r: float(r.att[-1, 2]), figure=False),
+       lambda r: float(r.last["att"][2]), figure=False),
 )
 _BY_NAME = {m.name: m for m in TABLE}
 NAMES = tuple(_BY_NAME)                                            #: every metric, in order
@@ -327,10 +403,27 @@ def gnss_outages(refs, dt, end_s=None):
 
 def run_metrics(spec, res):
     """The run metrics of one run (SI units): ``res`` holds its records
-    and truth (a records.FilResult); {} when it has no records."""
+    and truth (a records.FilResult); {} when it has no records. The same
+    figures as `scored` on the records in chunks (`records.score_variant`)."""
     if len(res.outputs) == 0:
         return {}
-    run = _Run(spec, res)                                            # 1.
+    run = start(spec, float(res.outputs["tick"][-1]) * res.dt)        # 1.
+    run.add(res)
+    return scored(run)
+
+
+def start(spec, end_s):
+    """A run's metrics to be folded chunk by chunk (``.add(FilResult)``, in
+    tick order), the last record at ``end_s`` [s]; `scored` gives them."""
+    return _Run(spec, end_s)
+
+
+def scored(run):
+    """The run metrics (SI units) of a `start`ed run that has folded in all
+    its records; {} when it had none."""
+    if run.last is None:
+        return {}
+    spec = run.spec
     stages = [*(["position"] if run.navigates else []),
               *(["aided"] if run.navigates and getattr(spec, "refs", None) is not None else []),
               *(["outages"] if run.navigates and gnss_outages(getattr(spec, "refs", None), spec.dt) else []),
@@ -438,12 +531,16 @@ def aligned(cfg, hz, outputs):
     """A run's alignment for its summary: {"method", "time_s" (navigation
     began), "heading_sigma_arcmin" (then)}; None when it does not align or
     never reached navigation."""
-    method = alignment_method(cfg, hz)
-    if method is None or not len(outputs):
+    if not len(outputs):
         return None
     nav = np.flatnonzero(outputs["mode"] == abi.PYINS_MODE_NAVIGATE)
-    if not len(nav):
-        return None
-    first = outputs[nav[0]]
-    return dict(method=method, time_s=float(first["tick"]) / hz, heading_sigma_arcmin=alignment_heading_sigma(first))
+    return aligned_at(cfg, hz, outputs[nav[0]] if len(nav) else None)
 
+
+def aligned_at(cfg, hz, first):
+    """`aligned` from ``first``, the first navigating record (None: it never
+    navigated)."""
+    method = alignment_method(cfg, hz)
+    if method is None or first is None:
+        return None
+    return dict(method=method, time_s=float(first["tick"]) / hz, heading_sigma_arcmin=alignment_heading_sigma(first))

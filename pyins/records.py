@@ -28,11 +28,13 @@ import json
 import os
 import socket
 import sys
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
 from pyins import contract, metrics, sim
+from pyins.reference import abi
 from pyins.units import ARCSEC_TO_RAD
 
 #: The plant's record at each kept tick: true table angle, rate, encoder.
@@ -42,6 +44,10 @@ RECORDS = "records.json"
 CHECKPOINT = "checkpoint.json"
 CHECKPOINT_VERSION = 1
 CSV_MAX_ROWS = 20_000
+#: Records read back at a time when a finished variant is scored (`score_variant`):
+#: 3.5 MB of firmware records, whatever the run's length (a 72 h run with 1-s
+#: records peaks at 74 MiB with these, as with 60-s records; 120 MiB with 20,000).
+CHUNK_RECORDS = 5_000
 _SINKS = (("outputs.bin", contract.OUTPUT_DTYPE), ("plant.bin", PLANT_RECORD_DTYPE))
 
 
@@ -236,10 +242,9 @@ def load_written(record_dir):
                  for name, dtype in _SINKS)
 
 
-def load_records(record_dir):
-    """The records a run streamed to ``record_dir`` (complete or not), memory-
-    mapped, cut to the last checkpointed or completed tick: (outputs, plant,
-    info) with info the records.json dict."""
+def _record_count(record_dir):
+    """(records.json info, the number of whole records in both files up to the
+    last checkpointed or completed tick)."""
     with open(os.path.join(record_dir, RECORDS)) as f:
         info = json.load(f)
     ck = os.path.join(record_dir, CHECKPOINT)
@@ -247,11 +252,21 @@ def load_records(record_dir):
     if os.path.exists(ck) and not info.get("complete"):
         with open(ck) as f:
             n = json.load(f)["n_records"]
-    arrays = []
+    counts = []
     for name, dtype in _SINKS:
+        count = os.path.getsize(os.path.join(record_dir, name)) // dtype.itemsize
+        counts.append(count if n is None else min(n, count))
+    return info, counts
+
+
+def load_records(record_dir):
+    """The records a run streamed to ``record_dir`` (complete or not), memory-
+    mapped, cut to the last checkpointed or completed tick: (outputs, plant,
+    info) with info the records.json dict."""
+    info, counts = _record_count(record_dir)
+    arrays = []
+    for (name, dtype), count in zip(_SINKS, counts):
         path = os.path.join(record_dir, name)
-        count = os.path.getsize(path) // dtype.itemsize
-        count = count if n is None else min(n, count)
         arrays.append(np.memmap(path, dtype=dtype, mode="r", shape=(count,)) if count
                       else np.zeros(0, dtype=dtype))
     return arrays[0], arrays[1], info
@@ -345,15 +360,23 @@ def timeseries(res):
 
 def write_timeseries(vdir, res):
     """timeseries.npz (every record and its errors) and timeseries.csv (the
-    errors, at most CSV_MAX_ROWS rows) of a FilResult."""
+    errors, at most CSV_MAX_ROWS rows) of a FilResult held in memory
+    (`score_variant` writes the same from the records on disk)."""
     arrays = timeseries(res)
     e, out = metrics.nav_errors(res), arrays["outputs"]
     write_atomic(os.path.join(vdir, "timeseries.npz"), write=lambda f: np.savez(f, **arrays), sync=False)
     step = max(1, -(-len(out) // CSV_MAX_ROWS))
-    k = np.arange(0, len(out), step)
-    cols = np.column_stack([e.time_s[k], e.north_m[k], e.east_m[k], e.horizontal_m[k],
+    _write_csv(vdir, _csv_columns(e, out, np.arange(0, len(out), step)))
+
+
+def _csv_columns(e, out, k):
+    """timeseries.csv's columns at records k of errors e and firmware records out."""
+    return np.column_stack([e.time_s[k], e.north_m[k], e.east_m[k], e.horizontal_m[k],
                             e.vel_n_mps[k], e.att_n_rad[k] / ARCSEC_TO_RAD,
                             out["table_angle_rad"][k], out["yaw_p_rad"][k], out["mode"][k]])
+
+
+def _write_csv(vdir, cols):
     write_atomic(os.path.join(vdir, "timeseries.csv"), sync=False, write=lambda f: np.savetxt(
         f, cols, delimiter=",", fmt="%.10g", comments="",
         header="time_s,north_m,east_m,horizontal_m,vel_err_e_mps,vel_err_n_mps,vel_err_u_mps,"
@@ -369,3 +392,106 @@ def load_variant(record_dir, motion, dt):
     outputs, plant, info = load_records(record_dir)
     truth = sim.truth_at(motion, np.asarray(outputs["tick"]), dt=dt)
     return FilResult(outputs=outputs, plant=plant, truth=truth, dt=dt), info
+
+
+# ---------------------------------------------------------------------------
+# A finished variant scored from its records, chunk by chunk
+# ---------------------------------------------------------------------------
+_TS_ERRORS = (("time_s", ()), ("north_m", ()), ("east_m", ()), ("horizontal_m", ()), ("vel_err_n_mps", (3,)),
+              ("att_err_n_rad", (3,)))
+
+
+def _read_chunk(path, dtype, start, count):
+    """Records start .. start + count - 1 of a raw record file, read into memory
+    (not mapped: the pages of a mapping stay resident while it lives)."""
+    with open(path, "rb") as f:
+        f.seek(start * dtype.itemsize)
+        return np.fromfile(f, dtype=dtype, count=count)
+
+
+def _npy_member(zf, name, dtype, shape, chunks):
+    """One .npy member of an .npz (as np.savez writes it: stored, zip64), its
+    data from ``chunks`` (arrays or raw bytes, in order)."""
+    with zf.open(name + ".npy", "w", force_zip64=True) as fid:
+        np.lib.format.write_array_header_1_0(fid, {"descr": np.lib.format.dtype_to_descr(dtype),
+                                                   "fortran_order": False, "shape": shape})
+        for c in chunks:
+            fid.write(c if isinstance(c, bytes) else np.ascontiguousarray(c).tobytes())
+
+
+def _file_blocks(path, nbytes, block=1 << 22):
+    """The first ``nbytes`` of a file, in blocks of 4 MiB."""
+    with open(path, "rb") as f:
+        left = nbytes
+        while left > 0:
+            b = f.read(min(block, left))
+            if not b:
+                raise OSError(f"{path}: shorter than its records.json says")
+            left -= len(b)
+            yield b
+
+
+def score_variant(vdir, spec, chunk=CHUNK_RECORDS):
+    """A variant's records (``vdir``/records, complete or stopped) read back
+    ``chunk`` records at a time, so memory stays bounded for a run of any
+    length and record rate: its run metrics (`pyins.metrics.start`, the
+    same figures as `metrics.run_metrics` on the whole records), its
+    alignment (`metrics.aligned_at`) and ``timeseries.npz`` / ``.csv``
+    with the arrays `write_timeseries` writes. Returns (metrics, aligned,
+    records.json info); ({}, None, None) when the run wrote nothing."""
+    rdir = os.path.join(vdir, "records")
+    if not os.path.exists(os.path.join(rdir, RECORDS)):
+        return {}, None, None
+    info, (n, n_plant) = _record_count(rdir)
+    n = min(n, n_plant)
+    if n == 0:
+        return {}, None, info
+    out_path, plant_path = (os.path.join(rdir, name) for name, _ in _SINKS)
+    last = _read_chunk(out_path, contract.OUTPUT_DTYPE, n - 1, 1)
+    run = metrics.start(spec, float(last["tick"][0]) * spec.dt)
+    step = max(1, -(-n // CSV_MAX_ROWS))
+    rows, first_nav = [], None
+    tmp = {name: os.path.join(vdir, f".{name}.part{os.getpid()}") for name, _ in _TS_ERRORS}
+    try:
+        files = {name: open(path, "wb") for name, path in tmp.items()}
+        try:
+            for i in range(0, n, chunk):
+                m = min(chunk, n - i)
+                out = _read_chunk(out_path, contract.OUTPUT_DTYPE, i, m)
+                plant = _read_chunk(plant_path, PLANT_RECORD_DTYPE, i, m)
+                truth = sim.truth_at(spec.motion, np.asarray(out["tick"]), dt=spec.dt)
+                res = FilResult(outputs=out, plant=plant, truth=truth, dt=spec.dt)
+                run.add(res)
+                e = metrics.nav_errors(res)
+                for name, _ in _TS_ERRORS:
+                    files[name].write(np.ascontiguousarray(getattr(e, _TS_FIELD[name])).tobytes())
+                if first_nav is None:
+                    nav = np.flatnonzero(out["mode"] == abi.PYINS_MODE_NAVIGATE)
+                    first_nav = out[nav[0]].copy() if len(nav) else None
+                k = np.arange((-i) % step, m, step)
+                rows.append(_csv_columns(e, out, k))
+        finally:
+            for f in files.values():
+                f.close()
+
+        def write_npz(f):
+            with zipfile.ZipFile(f, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+                for name, tail in _TS_ERRORS:
+                    _npy_member(zf, name, np.dtype("<f8"), (n, *tail),
+                                _file_blocks(tmp[name], n * 8 * (tail[0] if tail else 1)))
+                _npy_member(zf, "outputs", contract.OUTPUT_DTYPE, (n,),
+                            _file_blocks(out_path, n * contract.OUTPUT_DTYPE.itemsize))
+                _npy_member(zf, "plant", PLANT_RECORD_DTYPE, (n,),
+                            _file_blocks(plant_path, n * PLANT_RECORD_DTYPE.itemsize))
+        write_atomic(os.path.join(vdir, "timeseries.npz"), write=write_npz, sync=False)
+    finally:
+        for path in tmp.values():
+            if os.path.exists(path):
+                os.remove(path)
+    _write_csv(vdir, np.concatenate(rows))
+    return metrics.scored(run), metrics.aligned_at(spec.config, 1.0 / spec.dt, first_nav), info
+
+
+#: The NavErrors field of each error array of timeseries.npz.
+_TS_FIELD = {"time_s": "time_s", "north_m": "north_m", "east_m": "east_m", "horizontal_m": "horizontal_m",
+             "vel_err_n_mps": "vel_n_mps", "att_err_n_rad": "att_n_rad"}

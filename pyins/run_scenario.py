@@ -22,10 +22,10 @@ import shutil
 import time
 
 from pyins import engine as engines
-from pyins import fil, metrics, records
+from pyins import fil, records
 from pyins.metrics import group_metrics
 from pyins.progress import phase
-from pyins.rundir import (FORMAT, RunDirError, check_run_dir, read_summary, hold_interrupts, load_variant, slug, variant_facts, write_summary,
+from pyins.rundir import (FORMAT, RunDirError, check_run_dir, read_summary, hold_interrupts, slug, variant_facts, write_summary,
                           written_durations, written_ticks)
 from pyins.units import ARCMIN_TO_RAD
 
@@ -139,17 +139,16 @@ def _variants(summary, specs, run_dir, progress, resume, log, engine, interrupte
                 checkpoint = int(round(CHECKPOINT_S / spec.dt))
                 bar = progress(spec.label) if progress else None
                 run(spec, engine, record_dir=os.path.join(vdir, "records"), resume=resume,
-                    checkpoint_ticks=checkpoint, chunk_ticks=min(fil.CHUNK_TICKS, checkpoint), progress=bar)
+                    checkpoint_ticks=checkpoint, chunk_ticks=min(fil.CHUNK_TICKS, checkpoint), progress=bar,
+                    keep_result=False)
                 with phase(bar, "metrics and time series"):       # a line: seconds for a 72 h run
-                    res, info = load_variant(run_dir, spec)
-                    mm = metrics.run_metrics(spec, res) if res is not None else {}
-                    with hold_interrupts(defer=True):     # the time series and "finished" together
-                        if res is not None and len(res.outputs):
-                            records.write_timeseries(vdir, res)
+                    # read back in chunks (bounded memory at any record rate); the time series
+                    # and "finished" together
+                    with hold_interrupts(defer=True):
+                        mm, al, info = records.score_variant(vdir, spec)
                         finished = True
                 entry.update(wall_s=time.perf_counter() - t0, ticks_done=int(info["ticks_done"]) if info else 0,
                              complete=bool(info and info.get("complete")), metrics=mm)
-                al = metrics.aligned(spec.config, 1.0 / spec.dt, res.outputs) if res is not None else None
                 if al is not None:
                     entry["aligned"] = al
             except KeyboardInterrupt as exc:

@@ -82,14 +82,14 @@ def test_no_finished_run_is_run_again_whenever_the_ctrl_c_comes(tmp_path, monkey
     dirs = {p.digest: p.dir.split("/")[-1] for p in camp.points}
     # 1. a full campaign, traced: where each run's last variant is done (its time series written)
     marks = []
-    write_ts = records.write_timeseries
+    write_ts = records.score_variant
     tracer = _Tracer()
 
-    def noting(vdir, res, *a, **k):
-        out = write_ts(vdir, res, *a, **k)
+    def noting(vdir, spec, *a, **k):
+        out = write_ts(vdir, spec, *a, **k)
         marks.append((os.path.basename(os.path.dirname(vdir)), tracer.n))
         return out
-    monkeypatch.setattr(records, "write_timeseries", noting)
+    monkeypatch.setattr(records, "score_variant", noting)
     _traced(tracer, campaign.run_campaign, camp, tmp_path / "full", workers=1, plots=False)
     n_variants = len(camp.variants or [None])
     ends = {}
