@@ -145,8 +145,15 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
     t0 = time.perf_counter()
     say(f"the budget: {len(pts)} grid point(s), one error-free closed-loop run and one budget each")
     tasks = [(_scenario(camp, group[0], every="1 s"), preset) for _, group in pts]
+    models = [None] * len(tasks)
     with concurrent.futures.ProcessPoolExecutor(min(workers, len(tasks))) as ex:
-        models = list(ex.map(_model, tasks))
+        futures = {ex.submit(_model, task): i for i, task in enumerate(tasks)}
+        for done, fut in enumerate(concurrent.futures.as_completed(futures), start=1):
+            i = futures[fut]
+            models[i] = fut.result()
+            el = time.perf_counter() - t0
+            say(f"  budget {done}/{len(tasks)}: {dict(pts[i][0])} ({models[i]['seconds']:.0f} s)"
+                + (f"; about {el / done * (len(tasks) - done):.0f} s left" if done < len(tasks) else ""))
     coef = coefficients(preset, draws)
     out_points = []
     for (values, _), model in zip(pts, models):

@@ -298,6 +298,9 @@ def test_campaign_budget_places_draws_held_to_the_closed_loop(tmp_path, capsys):
     for c in res["checks"]:
         assert abs(c["rel"]) <= 0.01, c
     assert "through the budget" in text and (out / "budget.md").exists()
+    # every phase says how far it is, with the time left until its last step
+    assert "budget 1/2:" in text and "budget 2/2:" in text and "check 3/3:" in text
+    assert text.count("s left") == 3, text       # after budget 1/2 and checks 1/3, 2/3
 
 
 @pytest.mark.parametrize("argv, words", [
