@@ -32,6 +32,7 @@ latitude is 1 nmi).
 import html
 import json
 import os
+import zipfile
 
 import numpy as np
 
@@ -69,6 +70,49 @@ def _fill_facts(run_dir, summary, scn):
 
 #: What a variant's timeseries.npz must hold for the figures
 _SERIES_KEYS = ("time_s", "north_m", "east_m", "horizontal_m", "vel_err_n_mps", "att_err_n_rad", "outputs")
+#: The fields of a variant's firmware records the figures and tables read; only these are
+#: loaded (a 72 h run with 1-s records: 200 B a record instead of 696, and the plant's
+#: records not at all), so a report of long runs holds about a third of their records.
+_REPORT_FIELDS = ("lat_rad", "height_m", "mode", "kf_sigma", "index_state", "index_step", "index_a_c",
+                  "index_a_s", "n_ref_used", "nav_mode", "nav_nis", "nav_sigma_pos_m", "ref_in_use",
+                  "table_angle_rad", "yaw_p_rad")
+#: Records read at a time from timeseries.npz's firmware records (3.5 MB).
+_READ_RECORDS = 5_000
+
+
+def load_series(path):
+    """A variant's timeseries.npz as the report holds it: the error arrays,
+    and its firmware records with only the fields the report reads
+    (`_REPORT_FIELDS`), read 5,000 records at a time (never the whole
+    records at once)."""
+    s = {}
+    with zipfile.ZipFile(path) as zf:
+        for name in zf.namelist():
+            key = name[:-4] if name.endswith(".npy") else name
+            if key == "plant":
+                continue
+            with zf.open(name) as f:
+                if key != "outputs":
+                    s[key] = np.lib.format.read_array(f, allow_pickle=False)
+                    continue
+                version = np.lib.format.read_magic(f)
+                read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                               else np.lib.format.read_array_header_2_0)
+                shape, fortran, dtype = read_header(f)
+                if fortran or len(shape) != 1 or dtype.names is None:
+                    raise ValueError(f"{name}: not a 1-d array of records")
+                kept = np.dtype([(n, dtype.fields[n][0]) for n in _REPORT_FIELDS if n in dtype.names])
+                out = np.empty(shape, dtype=kept)
+                for i in range(0, shape[0], _READ_RECORDS):
+                    m = min(_READ_RECORDS, shape[0] - i)
+                    buf = f.read(m * dtype.itemsize)
+                    if len(buf) != m * dtype.itemsize:
+                        raise ValueError(f"{name}: shorter than its header says")
+                    chunk = np.frombuffer(buf, dtype=dtype)
+                    for n in kept.names:
+                        out[n][i:i + m] = chunk[n]
+                s[key] = out
+    return s
 
 
 def load(run_dir):
@@ -101,8 +145,7 @@ def load(run_dir):
                 v["metrics"] = metrics.run_metrics(spec, res)
         elif os.path.exists(path):
             try:
-                with np.load(path, allow_pickle=False) as z:
-                    s = {k: z[k] for k in z.files}
+                s = load_series(path)
                 missing = [k for k in _SERIES_KEYS if k not in s]
                 if missing:
                     raise ValueError(f"no {', '.join(missing)}")
