@@ -33,6 +33,7 @@ starts), then named steps:
 import hashlib
 import math
 import os
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -166,7 +167,7 @@ def _joined(outs, recs):
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
             chunk_ticks=CHUNK_TICKS, dt=DT, nodes=5, progress=None, record_dir=None,
             checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None,
-            keep_result=True):
+            keep_result=True, checkpoint_wall_s=None):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -194,7 +195,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     before it are kept, as at a rejected sample).
 
     Checkpoints (need ``record_dir``): every ``checkpoint_ticks`` (rounded up
-    to whole chunks) the firmware snapshot, the plant state, the noise
+    to whole chunks; with ``checkpoint_wall_s``, also at least that many
+    seconds of wall time after the last one, and always at the end) the firmware snapshot, the plant state, the noise
     generator's state and the number of records written go to
     ``checkpoint.json`` (temporary file + rename, after the records are
     flushed to disk). With ``resume=True`` a run killed at any moment
@@ -212,6 +214,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         raise ValueError("run_fil: checkpoint_ticks and resume need record_dir")
     if checkpoint_ticks is not None and checkpoint_ticks <= 0:
         raise ValueError(f"run_fil: checkpoint_ticks must be > 0, got {checkpoint_ticks}")
+    if checkpoint_wall_s is not None and not checkpoint_wall_s >= 0.0:
+        raise ValueError(f"run_fil: checkpoint_wall_s must be >= 0, got {checkpoint_wall_s}")
     engines.check(engine)
     if engine == "native" and engines.native is not None and engines.native.plant is None:
         raise RuntimeError("the plant library libpyins_plant.so is not installed; run `pip install .`")
@@ -249,7 +253,7 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
         sink = records.RecordSink(record_dir, n_records, mode)
         if mode == "wb" and os.path.exists(ck_path):
             os.remove(ck_path)
-        last_ck = loop.done
+        last_ck, last_ck_wall = loop.done, time.monotonic()
 
     # 3. chunk by chunk: the ship's rates, the noise, the closed loop, the
     #    records. The next chunk's noise is drawn on a helper thread while
@@ -286,14 +290,16 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
 
             # 4. a checkpoint when one is due (and at the end)
             if sink is not None and (loop.done >= duration_ticks or
-                                     (checkpoint_ticks is not None and loop.done - last_ck >= checkpoint_ticks)):
+                                     (checkpoint_ticks is not None and loop.done - last_ck >= checkpoint_ticks
+                                      and (checkpoint_wall_s is None
+                                           or time.monotonic() - last_ck_wall >= checkpoint_wall_s))):
                 sink.sync()
                 if checkpoint_ticks is not None or resume:
                     records.write_checkpoint(ck_path, digest, loop.done, sink.n_records, loop.fw.snapshot(),
                                              loop.plant.snapshot(),
                                              rng_state if rng_state is not None else loop.rng.bit_generator.state)
                 records.write_records_json(record_dir, every, dt, duration_ticks, loop.done)
-                last_ck = loop.done
+                last_ck, last_ck_wall = loop.done, time.monotonic()
             if progress is not None:
                 progress(loop.done, duration_ticks)
     finally:

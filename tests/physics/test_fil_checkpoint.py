@@ -73,3 +73,24 @@ def test_checkpoint_arguments_are_checked():
         fil.run_fil(sim.Static(0.6, 0.0, 0.0), 10, checkpoint_ticks=5)
     with pytest.raises(ValueError, match="checkpoint_ticks must be > 0"):
         fil.run_fil(sim.Static(0.6, 0.0, 0.0), 10, record_dir="/tmp/x", checkpoint_ticks=0)
+
+
+@pytest.mark.parametrize("wall_s, expected", [(None, TICKS // (2 * CHUNK)), (0.0, TICKS // (2 * CHUNK)),
+                                              (1e9, 1)])
+def test_checkpoints_at_most_one_per_wall_interval(tmp_path, monkeypatch, wall_s, expected):
+    """checkpoint_wall_s spaces the checkpoints in wall time too (what a
+    run directory uses: a 72 h run took 130 of them in 3 s); the last one,
+    at the end, is always written; the records are the same."""
+    written = []
+    real = records.write_checkpoint
+
+    def counting(path, digest, done, *a, **k):
+        written.append(done)
+        return real(path, digest, done, *a, **k)
+    monkeypatch.setattr(records, "write_checkpoint", counting)
+    res = _run(str(tmp_path / "r"), checkpoint_ticks=2 * CHUNK, checkpoint_wall_s=wall_s)
+    assert len(written) == expected and written[-1] == TICKS
+    ref = _run(None)
+    assert res.outputs.tobytes() == ref.outputs.tobytes()
+    with pytest.raises(ValueError, match="checkpoint_wall_s"):
+        _run(str(tmp_path / "bad"), checkpoint_ticks=2 * CHUNK, checkpoint_wall_s=-1.0)
