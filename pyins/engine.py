@@ -103,8 +103,10 @@ class MirrorPlant:
         self._table, self._errors, self._record_dtype = table, errors, record_dtype
         self._st = turntable.PlantState(alpha_rad=float(alpha0))
 
-    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every):
-        """As `pyins.native.Plant.run`."""
+    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every, sums=None):
+        """As `pyins.native.Plant.run` (``sums`` is the compiled plant's shortcut
+        for a table at rest: this mirror sums the nodes at every tick, in the
+        order the sums were made, so the bits are the same without it)."""
         st = self._st
         tick0 = st.tick
         outs, recs = [], []

@@ -73,6 +73,10 @@ class _Loop:
         if self.period is not None:          # one period of the ship's rates serves every chunk
             self.omega, self.force, self.x, self.w = sim.node_rates(motion, np.arange(self.period), dt=dt,
                                                                     nodes=nodes)
+            # and their weighted sums, what a tick with the table at rest takes (the same bits)
+            self.sums = sim.node_sums(self.omega, self.force, self.w)
+        else:
+            self.sums = None
         self.done = 0
         self.bufs, self.slot, self.z = None, 1, None     # the noise's buffers (noise)
 
@@ -125,7 +129,7 @@ def _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0, g_noise
     if aider is None:
         try:
             return loop.plant.run(loop.fw, omega, force, x, w, period, phase0, g_noise, a_noise, n,
-                                  loop.dt, every)
+                                  loop.dt, every, sums=loop.sums)
         except contract.PlantError as exc:
             raise _Stopped(exc, exc.outputs, exc.records) from None
     now0 = tick0 + loop.done
@@ -144,7 +148,7 @@ def _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0, g_noise
             out, rec = loop.plant.run(loop.fw, *part,
                                       None if g_noise is None else g_noise[i:stop],
                                       None if a_noise is None else a_noise[i:stop],
-                                      stop - i, loop.dt, every)
+                                      stop - i, loop.dt, every, sums=loop.sums)
             outs.append(out)
             recs.append(rec)
             i = stop

@@ -370,18 +370,27 @@ class Plant:
         self._n_done = ffi.new("size_t *")
         self._n_out = ffi.new("size_t *")
 
-    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every):
+    def run(self, fw, omega, force, x, w, period, phase0, gyro_noise, accel_noise, n, dt, every, sums=None):
         """``n`` ticks of the closed loop around ``fw`` (a `Firmware`).
 
         omega, force: the ship's body rate and specific force at the
         quadrature nodes (x, w) of ``period`` ticks, starting at phase
         ``phase0`` (tiled when the motion repeats); gyro_noise, accel_noise:
-        (n, 3) white-noise increments or None. Returns (outputs, records) at
-        the ticks that are multiples of ``every``; PlantError at a rejected
-        sample.
+        (n, 3) white-noise increments or None; ``sums``: None or
+        `pyins.sim.node_sums` of omega, force (period, 3) each, which a tick
+        with the table at rest then reads instead of summing its nodes (the
+        same bits). Returns (outputs, records) at the ticks that are
+        multiples of ``every``; PlantError at a rejected sample.
         """
         omega, force = np.ascontiguousarray(omega), np.ascontiguousarray(force)
         x, w = np.ascontiguousarray(x), np.ascontiguousarray(w)
+        if sums is None:
+            s_omega = s_force = ffi.NULL
+        else:
+            if sums[0].shape != (period, 3) or sums[1].shape != (period, 3):
+                raise ValueError(f"Plant.run: the node sums must be ({period}, 3) each")
+            s_omega = ffi.from_buffer("double[]", np.ascontiguousarray(sums[0], dtype=np.float64))
+            s_force = ffi.from_buffer("double[]", np.ascontiguousarray(sums[1], dtype=np.float64))
         g_ptr = ffi.NULL if gyro_noise is None else ffi.from_buffer("double[]", gyro_noise)
         a_ptr = ffi.NULL if accel_noise is None else ffi.from_buffer("double[]", accel_noise)
         cap = n // every + 1
@@ -391,7 +400,8 @@ class Plant:
         status = plant.pyins_fil_run(
             fw.core, self._st, self._tab, self._err, ffi.from_buffer("double[]", omega),
             ffi.from_buffer("double[]", force), ffi.from_buffer("double[]", x),
-            ffi.from_buffer("double[]", w), len(x), period, phase0, g_ptr, a_ptr, n, dt, every,
+            ffi.from_buffer("double[]", w), s_omega, s_force, len(x), period, phase0, g_ptr, a_ptr, n, dt,
+            every,
             ffi.from_buffer("pyins_output[]", out, require_writable=True),
             ffi.cast("pyins_plant_record *", ffi.from_buffer(rec, require_writable=True)), cap,
             self._n_done, self._n_out)

@@ -96,6 +96,11 @@ def dump_inputs(out_dir, n):
     arrays = {"omega.bin": omega, "force.bin": force, "x.bin": x, "w.bin": w}
     if g_noise is not None:
         arrays.update({"gyro_noise.bin": g_noise, "accel_noise.bin": a_noise})
+    for name in ("sum_omega.bin", "sum_force.bin"):         # a stale sums file would be read
+        if os.path.exists(os.path.join(out_dir, name)):
+            os.remove(os.path.join(out_dir, name))
+    if loop.sums is not None:                               # what run_fil hands the plant
+        arrays.update({"sum_omega.bin": loop.sums[0], "sum_force.bin": loop.sums[1]})
     for name, arr in arrays.items():
         put(name, np.ascontiguousarray(arr, dtype=np.float64).tobytes())
 

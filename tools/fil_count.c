@@ -11,6 +11,8 @@
  *   omega.bin, force.bin   period * nodes * 3 doubles (the ship's node rates)
  *   x.bin, w.bin      nodes doubles (Gauss-Legendre abscissae and weights)
  *   gyro_noise.bin, accel_noise.bin   n * 3 doubles (absent: no noise)
+ *   sum_omega.bin, sum_force.bin   period * 3 doubles, the weighted node
+ *                     sums of a table at rest (absent: summed per tick)
  * Calls pyins_fil_run once over all n ticks and prints the ticks done and
  * the last kept output's lat_rad (%.17g), which bench_fil.py compares with
  * the Python run's bit for bit. */
@@ -88,7 +90,7 @@ int main(int argc, char **argv) {
     double dt;
     size_t size = 0, n, capacity, n_done = 0, n_out = 0;
     unsigned char *pbuf;
-    double *omega, *force, *x, *w, *g_noise, *a_noise;
+    double *omega, *force, *x, *w, *g_noise, *a_noise, *sum_omega, *sum_force;
     pyins_output *outputs;
     pyins_plant_record *records;
     int status;
@@ -124,6 +126,8 @@ int main(int argc, char **argv) {
     w = read_doubles("w.bin", (size_t)params[1], 0);
     g_noise = read_doubles("gyro_noise.bin", n * 3u, 1);
     a_noise = read_doubles("accel_noise.bin", n * 3u, 1);
+    sum_omega = read_doubles("sum_omega.bin", (size_t)params[0] * 3u, 1);
+    sum_force = read_doubles("sum_force.bin", (size_t)params[0] * 3u, 1);
 
     if (pyins_core_size() > sizeof mem || pyins_core_align() > 64u) {
         fprintf(stderr, "fil_count: instance (%zu bytes, alignment %zu) does not fit the static buffer\n",
@@ -142,7 +146,8 @@ int main(int argc, char **argv) {
         fprintf(stderr, "fil_count: out of memory\n");
         return 2;
     }
-    status = pyins_fil_run((pyins_core *)mem, &st, &table, &err, omega, force, x, w, (int32_t)params[1],
+    status = pyins_fil_run((pyins_core *)mem, &st, &table, &err, omega, force, x, w, sum_omega, sum_force,
+                           (int32_t)params[1],
                            params[0], params[4], g_noise, a_noise, n, dt, (size_t)params[2], outputs,
                            records, capacity, &n_done, &n_out);
     if (status != PYINS_OK) {
@@ -163,5 +168,7 @@ int main(int argc, char **argv) {
     free(w);
     free(g_noise);
     free(a_noise);
+    free(sum_omega);
+    free(sum_force);
     return 0;
 }

@@ -68,7 +68,7 @@ bool same_bits(double a, double b) {
 extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyins_table_config* table,
                              const pyins_imu_errors* err, const double* node_omega_b,
                              const double* node_force_b, const double* node_x, const double* node_w,
-                             int32_t n_nodes, int64_t period, int64_t phase0, const double* gyro_noise,
+                             const double* node_sum_omega, const double* node_sum_force, int32_t n_nodes, int64_t period, int64_t phase0, const double* gyro_noise,
                              const double* accel_noise, size_t n, double dt, size_t every,
                              pyins_output* outputs, pyins_plant_record* records, size_t capacity,
                              size_t* n_done, size_t* n_out) {
@@ -116,12 +116,21 @@ extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyin
             trig(st->alpha_rad);
             double w_sum[3] = {0.0, 0.0, 0.0};
             double f_sum[3] = {0.0, 0.0, 0.0};
-            for (int32_t j = 0; j < n_nodes; ++j) {
-                const double* w_b = node_omega_b + 3 * (base + j);
-                const double* f_b = node_force_b + 3 * (base + j);
+            if (node_sum_omega != nullptr && node_sum_force != nullptr) {
+                // the caller's sums of this tick of the period (the same order, the same bits)
+                const int64_t row = 3 * (base / n_nodes);
                 for (int i = 0; i < 3; ++i) {
-                    w_sum[i] = w_sum[i] + node_w[j] * w_b[i];
-                    f_sum[i] = f_sum[i] + node_w[j] * f_b[i];
+                    w_sum[i] = node_sum_omega[row + i];
+                    f_sum[i] = node_sum_force[row + i];
+                }
+            } else {
+                for (int32_t j = 0; j < n_nodes; ++j) {
+                    const double* w_b = node_omega_b + 3 * (base + j);
+                    const double* f_b = node_force_b + 3 * (base + j);
+                    for (int i = 0; i < 3; ++i) {
+                        w_sum[i] = w_sum[i] + node_w[j] * w_b[i];
+                        f_sum[i] = f_sum[i] + node_w[j] * f_b[i];
+                    }
                 }
             }
             const double c = trig_c;

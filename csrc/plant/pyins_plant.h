@@ -78,7 +78,12 @@ typedef struct pyins_plant_record {
 /* Run n ticks of the closed loop. For tick k (0-based in this call), the
  * ship's omega_ib^b and f^b at node j are node_omega_b / node_force_b
  * [((phase0 + k) % period) * n_nodes + j][3]; node_x, node_w are the
- * Gauss-Legendre abscissae on [-1, 1] and weights. gyro_noise / accel_noise
+ * Gauss-Legendre abscissae on [-1, 1] and weights. node_sum_omega /
+ * node_sum_force (may be NULL) are, per tick of the period [(phase0 + k) %
+ * period][3], the weighted node sums sum_j node_w[j] * value[j] summed from
+ * 0.0 in the order j = 0 .. n_nodes - 1: what a tick with the table at rest
+ * takes (NULL: summed at every such tick; the same bits either way).
+ * gyro_noise / accel_noise
  * (n x 3, may be NULL) are added per tick [rad, m/s]. After every tick whose
  * number (st->tick after it) is a multiple of every, the firmware's output
  * and the plant record are written (capacity must hold n / every + 1).
@@ -88,7 +93,8 @@ typedef struct pyins_plant_record {
  * Returns PYINS_OK or the firmware's / a negative pyins_status. */
 int pyins_fil_run(pyins_core *core, pyins_plant_state *st, const pyins_table_config *table,
                   const pyins_imu_errors *err, const double *node_omega_b, const double *node_force_b,
-                  const double *node_x, const double *node_w, int32_t n_nodes, int64_t period,
+                  const double *node_x, const double *node_w, const double *node_sum_omega,
+                  const double *node_sum_force, int32_t n_nodes, int64_t period,
                   int64_t phase0, const double *gyro_noise, const double *accel_noise, size_t n,
                   double dt, size_t every, pyins_output *outputs, pyins_plant_record *records,
                   size_t capacity, size_t *n_done, size_t *n_out);

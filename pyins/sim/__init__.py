@@ -35,7 +35,7 @@ the tick and the unit constants are `pyins.units`'. The Earth model is
 ``pyins.reference.earth``, the same as the firmware's.
 """
 from pyins.sim.imu import (Chunk, Truth, body_rate_and_force, euler_to_mat, euler_to_quat,
-                           exact_increments, generate, nb_rate_and_derivative, node_rates, truth,
+                           exact_increments, generate, nb_rate_and_derivative, node_rates, node_sums, truth,
                            truth_at)
 from pyins.sim.io import (CSV_COLUMNS, CSV_HEADER, ImuData, load_csv, load_npz, save_csv,
                           save_npz)
@@ -50,7 +50,7 @@ from pyins.sim.voyage import Voyage, default_voyage
 
 __all__ = [
     "Chunk", "Truth", "body_rate_and_force", "euler_to_mat", "euler_to_quat",
-    "exact_increments", "generate", "nb_rate_and_derivative", "node_rates", "truth", "truth_at",
+    "exact_increments", "generate", "nb_rate_and_derivative", "node_rates", "node_sums", "truth", "truth_at",
     "CSV_COLUMNS", "CSV_HEADER", "ImuData", "load_csv", "load_npz", "save_csv", "save_npz",
     "SEA_STATES", "HeadingSwing", "Manoeuvre", "Motion", "MotionState", "NarrowbandYaw", "Segment", "Static",
     "Swing", "default_segments", "sea_state",

@@ -305,6 +305,20 @@ def node_rates(motion, ticks, dt=DT, t0=0.0, nodes=5):
     return omega.reshape(n, nodes, 3), force.reshape(n, nodes, 3), x, w
 
 
+def node_sums(omega, force, w):
+    """The weighted node sums sum_j w[j] * omega[:, j] and sum_j w[j] *
+    force[:, j] ((n, 3) each) of `node_rates`' arrays, summed from 0.0 in
+    the order j = 0, 1, ...: a tick with the table at rest takes exactly
+    these (pyins_plant.h, ``node_sum_omega``; the plant's own loop adds in
+    the same order, so the bits are the same)."""
+    so = np.zeros((omega.shape[0], 3))
+    sf = np.zeros((force.shape[0], 3))
+    for j in range(len(w)):
+        so = so + w[j] * omega[:, j, :]
+        sf = sf + w[j] * force[:, j, :]
+    return so, sf
+
+
 def _table_angle_end(table, ticks, dt, t0):
     if table is None:
         return np.zeros(len(ticks))
