@@ -8,7 +8,9 @@ A record directory (``fil.run_fil(record_dir=...)``) holds::
     checkpoint.json   the last checkpoint (firmware, plant, noise generator)
 
 A variant directory of a run (``pyins.rundir``) adds ``timeseries.npz`` and
-``timeseries.csv``: the records beside their errors against the truth.
+``timeseries.csv``: the records beside their errors against the truth,
+written by `score_variant` from the record files read back in chunks (with
+the run's metrics), so memory stays bounded at any record rate.
 
 Every file that a kill may interrupt is written through a temporary file
 and a rename (`write_atomic`), so a kill at any moment leaves the old file
