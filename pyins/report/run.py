@@ -96,6 +96,10 @@ def load_series(path):
                     s[key] = np.lib.format.read_array(f, allow_pickle=False)
                     continue
                 version = np.lib.format.read_magic(f)
+                if version not in ((1, 0), (2, 0)):      # a newer layout: read whole, then keep the fields
+                    with zf.open(name) as g:
+                        s[key] = _kept_fields(np.lib.format.read_array(g, allow_pickle=False))
+                    continue
                 read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
                                else np.lib.format.read_array_header_2_0)
                 shape, fortran, dtype = read_header(f)
@@ -113,6 +117,15 @@ def load_series(path):
                         out[n][i:i + m] = chunk[n]
                 s[key] = out
     return s
+
+
+def _kept_fields(records):
+    """``records`` with only the fields of `_REPORT_FIELDS` it has, packed."""
+    kept = np.dtype([(n, records.dtype.fields[n][0]) for n in _REPORT_FIELDS if n in records.dtype.names])
+    out = np.empty(records.shape, dtype=kept)
+    for n in kept.names:
+        out[n] = records[n]
+    return out
 
 
 def load(run_dir):

@@ -128,9 +128,11 @@ def test_ctrl_c_leaves_a_partial_result_that_resume_completes(tmp_path):
                             # a job started in the background inherits SIGINT ignored, and Python
                             # then installs no KeyboardInterrupt handler: restore the default
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    rec = out / "no_rotation" / "records" / "records.json"
+    # the first chunk's records on disk: the first variant is under way (its first checkpoint, and
+    # records.json with it, comes only 2 s of wall time in: run_scenario.CHECKPOINT_WALL_S)
+    rec = out / "no_rotation" / "records" / "outputs.bin"
     t0 = time.monotonic()
-    while not rec.exists() and time.monotonic() - t0 < 120:
+    while not (rec.exists() and rec.stat().st_size > 0) and time.monotonic() - t0 < 120:
         assert proc.poll() is None, proc.stderr.read()
         time.sleep(0.02)
     proc.send_signal(signal.SIGINT)

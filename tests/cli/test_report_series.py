@@ -43,3 +43,19 @@ def test_a_cut_file_is_an_error(npz, tmp_path):
     with pytest.raises((zipfile.BadZipFile, ValueError, OSError)):   # the report names it damaged
         #                                                             (tests/cli/test_run_defects.py)
         report_run.load_series(cut)
+
+
+def test_a_newer_npy_layout_is_read_whole_and_kept_to_the_fields(npz, tmp_path):
+    """A member written in .npy format 3.0 (utf-8 field names) is read with
+    NumPy's own reader, then kept to the report's fields: the same values."""
+    with np.load(npz) as z:
+        whole = {k: z[k] for k in z.files}
+    v3 = tmp_path / "v3.npz"
+    with zipfile.ZipFile(v3, "w") as zf:
+        for k, arr in whole.items():
+            with zf.open(k + ".npy", "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, arr, version=(3, 0) if k == "outputs" else None)
+    s = report_run.load_series(v3)
+    assert s["outputs"].dtype.names == report_run._REPORT_FIELDS
+    for n in report_run._REPORT_FIELDS:
+        assert s["outputs"][n].tobytes() == whole["outputs"][n].tobytes(), n
