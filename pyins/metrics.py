@@ -231,11 +231,21 @@ class _Run:
 
 def _fold(acc, x):
     """acc = [s, r] (a sum carried as its rounded value and remainder) plus
-    the values x, rounded once (math.fsum): the same whatever the chunks."""
+    the values x, rounded once (math.fsum): the same whatever the chunks.
+    A sum that is not finite (an inf or NaN among the values, or past the
+    largest double) is what ndarray.sum gives, inf or NaN, as the whole
+    records' mean would be."""
     values = [acc[0], acc[1], *x.tolist()]
-    s = math.fsum(values)
-    values.append(-s)
-    acc[1] = math.fsum(values)
+    try:
+        s = math.fsum(values)
+    except (OverflowError, ValueError):      # past the largest double; inf - inf
+        with np.errstate(over="ignore", invalid="ignore"):
+            s = float(np.sum(values))
+    if math.isfinite(s):
+        values.append(-s)
+        acc[1] = math.fsum(values)
+    else:
+        acc[1] = 0.0
     acc[0] = s
 
 

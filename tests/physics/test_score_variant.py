@@ -71,3 +71,19 @@ def test_the_outage_windows_see_every_chunk():
     for i in range(0, len(x), 97):
         metrics._fold(b, x[i:i + 97] ** 2)
     assert a[0] == b[0]
+
+
+@pytest.mark.parametrize("values, want", [([1.0, np.inf, 2.0], np.inf), ([1.0, np.nan], np.nan),
+                                          ([1e308] * 4, np.inf), ([np.inf, np.nan], np.nan)])
+def test_a_sum_that_is_not_finite_is_what_the_mean_of_the_whole_gives(values, want):
+    """A diverged run (an inf or NaN error, or squares past the largest
+    double) scores inf or NaN as np.mean over the whole records did, in any
+    chunking, and never raises (math.fsum alone raises on inf - inf and on
+    overflow)."""
+    for chunk in (1, 2, len(values)):
+        acc = [0.0, 0.0]
+        for i in range(0, len(values), chunk):
+            metrics._fold(acc, np.array(values[i:i + chunk]))
+        with np.errstate(over="ignore", invalid="ignore"):
+            whole = np.mean(np.array(values))
+        assert (np.isnan(acc[0]) and np.isnan(want) and np.isnan(whole)) or acc[0] == want == whole
