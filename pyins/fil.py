@@ -171,7 +171,7 @@ def _joined(outs, recs):
 def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None, every=100,
             chunk_ticks=CHUNK_TICKS, dt=DT, nodes=5, progress=None, record_dir=None,
             checkpoint_ticks=None, resume=False, engine="native", refs=None, avail_tick=None,
-            keep_result=True, checkpoint_wall_s=None):
+            keep_result=True, checkpoint_wall_s=None, draw_ahead=True):
     """Run the closed loop for ``duration_ticks``.
 
     ``config``: firmware configuration overrides (default: the true initial
@@ -197,6 +197,11 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     firmware applies it at exactly its tick). A reference the firmware
     refuses raises contract.RefError with its index in ``refs`` (the records
     before it are kept, as at a rejected sample).
+
+    ``draw_ahead``: draw the next chunk's noise on a helper thread while
+    this chunk's loop runs (a run then keeps about 1.6 cores busy); False
+    draws it in the loop's own thread just before the chunk (one core; what
+    a pool with a worker per core may prefer). The same draws either way.
 
     Checkpoints (need ``record_dir``): every ``checkpoint_ticks`` (rounded up
     to whole chunks; with ``checkpoint_wall_s``, also at least that many
@@ -263,16 +268,19 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     #    records. The next chunk's noise is drawn on a helper thread while
     #    this chunk's loop runs (both release the GIL): the same draws in the
     #    same order as one after the other.
-    ahead = ThreadPoolExecutor(max_workers=1)
+    ahead = ThreadPoolExecutor(max_workers=1) if draw_ahead else None
     try:
         pending = (ahead.submit(loop.noise, min(chunk_ticks, duration_ticks - loop.done))
-                   if loop.done < duration_ticks else None)
+                   if ahead is not None and loop.done < duration_ticks else None)
         while loop.done < duration_ticks:
             n = min(chunk_ticks, duration_ticks - loop.done)
             omega, force, x, w, period, phase0 = loop.ship_rates(n)
-            g_noise, a_noise, rng_state = pending.result()
-            n_next = min(chunk_ticks, duration_ticks - loop.done - n)
-            pending = ahead.submit(loop.noise, n_next) if n_next > 0 else None
+            if ahead is None:
+                g_noise, a_noise, rng_state = loop.noise(n)
+            else:
+                g_noise, a_noise, rng_state = pending.result()
+                n_next = min(chunk_ticks, duration_ticks - loop.done - n)
+                pending = ahead.submit(loop.noise, n_next) if n_next > 0 else None
             try:
                 out, rec = _closed_loop(loop, aider, tick0, omega, force, x, w, period, phase0,
                                         g_noise, a_noise, n, every)
@@ -307,7 +315,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
             if progress is not None:
                 progress(loop.done, duration_ticks)
     finally:
-        ahead.shutdown(wait=True, cancel_futures=True)
+        if ahead is not None:
+            ahead.shutdown(wait=True, cancel_futures=True)
 
     # 5. the result: the records beside the truth
     if sink is not None:

@@ -23,7 +23,9 @@ seed 002's sensor errors, noise seeded per run).
    e.g. the noise drawn ahead on a helper thread), and the ratio the CPU
    times allow (2 / that share), so a shortfall can be put on the program
    (its helper thread, its memory traffic: the CPU time per run grows with
-   two at once) or on the machine.
+   two at once) or on the machine. Then the same with the noise drawn in
+   the loop's own thread (``run_fil(draw_ahead=False)``: each run one
+   core): two such workers against one, and against one drawing ahead.
 
 4. (``--dask``) the campaign engine itself (`pyins.campaign.run_campaign`:
    a pool of workers that keep the libraries loaded) on --runs draws of
@@ -48,13 +50,15 @@ CHILD = r"""
 import sys, resource
 mode, hours, every, seed, out = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4]), sys.argv[5]
 n_runs = int(sys.argv[6]) if len(sys.argv) > 6 else 1
+ahead = mode != "run_fil_serial"
+mode = "run_fil" if mode == "run_fil_serial" else mode
 from pyins import fil, metrics, sim, scenario, run_scenario
 peaks = []
 for k in range(n_runs):
     if mode == "run_fil":
         res = fil.run_fil(sim.HeadingSwing.experiment(1), int(round(hours * 360_000)),
                           config=dict(index_scheme=4), errors=sim.preset("seed002"), seed=seed + k,
-                          every=int(round(every * 100)))
+                          every=int(round(every * 100)), draw_ahead=ahead)
         metrics.nav_errors(res)
     else:
         scn = scenario.load("seed002_exp1").with_overrides(
@@ -176,25 +180,33 @@ def main(argv=None):
         peaks = [float(x) for x in r["stdout"].split()]
         print("   peak after each run [MiB]: " + ", ".join(f"{p:.0f}" for p in peaks))
         fig["peak_mib_after_each_run"] = peaks
-    print(f"\n3. the closed loop ({a.hours:g} h, records every 60 s, run_fil) x {a.runs}: one worker, then two")
-    jobs = [["run_fil", a.hours, 60, s, work] for s in range(a.runs)]
+    print(f"\n3. the closed loop ({a.hours:g} h, records every 60 s, run_fil) x {a.runs}: one worker, then two;"
+          f"\n   the noise drawn ahead on a helper thread (run_fil's default), then in the loop's thread")
     rows = {}
-    for width in (1, 2):
+    for key, width, mode in ((1, 1, "run_fil"), (2, 2, "run_fil"), ("serial_1", 1, "run_fil_serial"),
+                             ("serial_2", 2, "run_fil_serial")):
+        jobs = [[mode, a.hours, 60, s, work] for s in range(a.runs)]
         wall, done = batch(jobs, width)
         cpu = [d["user_s"] + d["sys_s"] for d in done]
         per = [d["wall_s"] for d in done]
-        rows[width] = {"wall_s": wall, "runs_per_s": a.runs / wall,
-                       "run_wall_s_median": sorted(per)[len(per) // 2],
-                       "run_cpu_s_median": sorted(cpu)[len(cpu) // 2],
-                       "cpu_share_median": sorted(c / w for c, w in zip(cpu, per))[len(per) // 2]}
-        print(f"   {width} worker{'s' if width > 1 else ' '}: {wall:6.1f} s for {a.runs} runs, "
-              f"{rows[width]['runs_per_s']:.3f} runs/s; a run: {rows[width]['run_wall_s_median']:.2f} s wall, "
-              f"{rows[width]['run_cpu_s_median']:.2f} s CPU (CPU / wall {rows[width]['cpu_share_median']:.2f})")
+        rows[key] = {"wall_s": wall, "runs_per_s": a.runs / wall,
+                     "run_wall_s_median": sorted(per)[len(per) // 2],
+                     "run_cpu_s_median": sorted(cpu)[len(cpu) // 2],
+                     "cpu_share_median": sorted(c / w for c, w in zip(cpu, per))[len(per) // 2]}
+        how = "ahead " if mode == "run_fil" else "serial"
+        print(f"   {how} {width} worker{'s' if width > 1 else ' '}: {wall:6.1f} s for {a.runs} runs, "
+              f"{rows[key]['runs_per_s']:.3f} runs/s; a run: {rows[key]['run_wall_s_median']:.2f} s wall, "
+              f"{rows[key]['run_cpu_s_median']:.2f} s CPU (CPU / wall {rows[key]['cpu_share_median']:.2f})")
     ratio = rows[2]["runs_per_s"] / rows[1]["runs_per_s"]
     allowed = 2.0 / max(1.0, rows[1]["cpu_share_median"])
     growth = rows[2]["run_cpu_s_median"] / rows[1]["run_cpu_s_median"]
     print(f"   two workers / one: {ratio:.2f}x the runs per second (target 1.8x); what one run's CPU share "
           f"alone allows: {allowed:.2f}x; a run's CPU time with two at once / alone: {growth:.2f}")
+    serial = rows["serial_2"]["runs_per_s"] / rows["serial_1"]["runs_per_s"]
+    print(f"   the noise in the loop's thread: two workers / one {serial:.2f}x (each run one core); two "
+          f"such workers / one worker drawing ahead {rows['serial_2']['runs_per_s'] / rows[1]['runs_per_s']:.2f}x")
+    fig.update({"serial_one_worker": rows["serial_1"], "serial_two_workers": rows["serial_2"],
+                "serial_throughput_ratio": serial})
     fig.update({"one_worker": rows[1], "two_workers": rows[2], "throughput_ratio": ratio,
                 "ratio_cpu_share_allows": allowed, "cpu_time_growth_two_at_once": growth,
                 "load_1min_after": os.getloadavg()[0]})

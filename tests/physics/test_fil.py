@@ -177,3 +177,15 @@ def test_the_node_sums_of_a_table_at_rest_change_no_bit(monkeypatch, name):
     plain = run_scenario.run(spec)
     assert with_sums.outputs.tobytes() == plain.outputs.tobytes()
     assert with_sums.plant.tobytes() == plain.plant.tobytes()
+
+
+def test_the_noise_drawn_in_the_loops_thread_is_the_same_noise():
+    """run_fil(draw_ahead=False) draws each chunk's noise in the loop's own
+    thread (a run on one core, what tools/bench_campaign.py compares): the
+    same draws in the same order as the helper thread's, so every record is
+    the same, bit for bit, over several chunks of a noisy indexed run."""
+    m, errors = sim.HeadingSwing.experiment(1), sim.preset("seed002")
+    runs = [fil.run_fil(m, 250_000, config=dict(index_scheme=4), errors=errors, seed=3, every=100,
+                        chunk_ticks=60_000, draw_ahead=ahead) for ahead in (True, False)]
+    assert runs[0].outputs.tobytes() == runs[1].outputs.tobytes()
+    assert runs[0].plant.tobytes() == runs[1].plant.tobytes()
