@@ -133,11 +133,12 @@ class _Run:
         self.window_max = [0.0] * len(self.windows)
         self.last = None          # the last record's errors, truth and filter state
 
-    def add(self, res):
-        """Fold in the next chunk of records (a records.FilResult, in tick order)."""
+    def add(self, res, errors=None):
+        """Fold in the next chunk of records (a records.FilResult, in tick order);
+        ``errors``: its `nav_errors` when the caller has them already."""
         if len(res.outputs) == 0:
             return
-        e = nav_errors(res)
+        e = nav_errors(res) if errors is None else errors
         att = e.att_n_rad
         nav = np.asarray(res.outputs["mode"]) == abi.PYINS_MODE_NAVIGATE
         per = {"h": e.horizontal_m, "level": np.abs(att[:, :2]).max(axis=1), "heading": np.abs(att[:, 2]),

@@ -351,13 +351,18 @@ def write_checkpoint(path, digest, done, n_records, firmware, plant, rng_state):
 # ---------------------------------------------------------------------------
 # A run's variant directory
 # ---------------------------------------------------------------------------
+#: timeseries.npz's error arrays, in its order: (name, the metrics.NavErrors field, shape per record).
+_TS_ERRORS = (("time_s", "time_s", ()), ("north_m", "north_m", ()), ("east_m", "east_m", ()),
+              ("horizontal_m", "horizontal_m", ()), ("vel_err_n_mps", "vel_n_mps", (3,)),
+              ("att_err_n_rad", "att_n_rad", (3,)))
+
+
 def timeseries(res):
     """The arrays of timeseries.npz of a FilResult: every record and its
     errors against the truth."""
     e = metrics.nav_errors(res)
-    return dict(time_s=e.time_s, north_m=e.north_m, east_m=e.east_m, horizontal_m=e.horizontal_m,
-                vel_err_n_mps=e.vel_n_mps, att_err_n_rad=e.att_n_rad, outputs=np.asarray(res.outputs),
-                plant=np.asarray(res.plant))
+    return {**{name: getattr(e, field) for name, field, _ in _TS_ERRORS},
+            "outputs": np.asarray(res.outputs), "plant": np.asarray(res.plant)}
 
 
 def write_timeseries(vdir, res):
@@ -399,10 +404,6 @@ def load_variant(record_dir, motion, dt):
 # ---------------------------------------------------------------------------
 # A finished variant scored from its records, chunk by chunk
 # ---------------------------------------------------------------------------
-_TS_ERRORS = (("time_s", ()), ("north_m", ()), ("east_m", ()), ("horizontal_m", ()), ("vel_err_n_mps", (3,)),
-              ("att_err_n_rad", (3,)))
-
-
 def _read_chunk(path, dtype, start, count):
     """Records start .. start + count - 1 of a raw record file, read into memory
     (not mapped: the pages of a mapping stay resident while it lives)."""
@@ -453,7 +454,7 @@ def score_variant(vdir, spec, chunk=CHUNK_RECORDS):
     run = metrics.start(spec, float(last["tick"][0]) * spec.dt)
     step = max(1, -(-n // CSV_MAX_ROWS))
     rows, first_nav = [], None
-    tmp = {name: os.path.join(vdir, f".{name}.part{os.getpid()}") for name, _ in _TS_ERRORS}
+    tmp = {name: os.path.join(vdir, f".{name}.part{os.getpid()}") for name, _, _ in _TS_ERRORS}
     try:
         files = {name: open(path, "wb") for name, path in tmp.items()}
         try:
@@ -463,10 +464,10 @@ def score_variant(vdir, spec, chunk=CHUNK_RECORDS):
                 plant = _read_chunk(plant_path, PLANT_RECORD_DTYPE, i, m)
                 truth = sim.truth_at(spec.motion, np.asarray(out["tick"]), dt=spec.dt)
                 res = FilResult(outputs=out, plant=plant, truth=truth, dt=spec.dt)
-                run.add(res)
                 e = metrics.nav_errors(res)
-                for name, _ in _TS_ERRORS:
-                    files[name].write(np.ascontiguousarray(getattr(e, _TS_FIELD[name])).tobytes())
+                run.add(res, e)
+                for name, field, _ in _TS_ERRORS:
+                    files[name].write(np.ascontiguousarray(getattr(e, field)).tobytes())
                 if first_nav is None:
                     nav = np.flatnonzero(out["mode"] == abi.PYINS_MODE_NAVIGATE)
                     first_nav = out[nav[0]].copy() if len(nav) else None
@@ -478,7 +479,7 @@ def score_variant(vdir, spec, chunk=CHUNK_RECORDS):
 
         def write_npz(f):
             with zipfile.ZipFile(f, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
-                for name, tail in _TS_ERRORS:
+                for name, _, tail in _TS_ERRORS:
                     _npy_member(zf, name, np.dtype("<f8"), (n, *tail),
                                 _file_blocks(tmp[name], n * 8 * (tail[0] if tail else 1)))
                 _npy_member(zf, "outputs", contract.OUTPUT_DTYPE, (n,),
@@ -492,8 +493,3 @@ def score_variant(vdir, spec, chunk=CHUNK_RECORDS):
                 os.remove(path)
     _write_csv(vdir, np.concatenate(rows))
     return metrics.scored(run), metrics.aligned_at(spec.config, 1.0 / spec.dt, first_nav), info
-
-
-#: The NavErrors field of each error array of timeseries.npz.
-_TS_FIELD = {"time_s": "time_s", "north_m": "north_m", "east_m": "east_m", "horizontal_m": "horizontal_m",
-             "vel_err_n_mps": "vel_n_mps", "att_err_n_rad": "att_n_rad"}

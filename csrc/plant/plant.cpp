@@ -68,8 +68,9 @@ bool same_bits(double a, double b) {
 extern "C" int pyins_fil_run(pyins_core* core, pyins_plant_state* st, const pyins_table_config* table,
                              const pyins_imu_errors* err, const double* node_omega_b,
                              const double* node_force_b, const double* node_x, const double* node_w,
-                             const double* node_sum_omega, const double* node_sum_force, int32_t n_nodes, int64_t period, int64_t phase0, const double* gyro_noise,
-                             const double* accel_noise, size_t n, double dt, size_t every,
+                             const double* node_sum_omega, const double* node_sum_force, int32_t n_nodes,
+                             int64_t period, int64_t phase0, const double* gyro_noise, const double* accel_noise,
+                             size_t n, double dt, size_t every,
                              pyins_output* outputs, pyins_plant_record* records, size_t capacity,
                              size_t* n_done, size_t* n_out) {
     if (n_done != nullptr) {

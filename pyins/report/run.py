@@ -105,7 +105,7 @@ def load_series(path):
                 shape, fortran, dtype = read_header(f)
                 if fortran or len(shape) != 1 or dtype.names is None:
                     raise ValueError(f"{name}: not a 1-d array of records")
-                kept = np.dtype([(n, dtype.fields[n][0]) for n in _REPORT_FIELDS if n in dtype.names])
+                kept = _kept_dtype(dtype)
                 out = np.empty(shape, dtype=kept)
                 for i in range(0, shape[0], _READ_RECORDS):
                     m = min(_READ_RECORDS, shape[0] - i)
@@ -119,9 +119,14 @@ def load_series(path):
     return s
 
 
+def _kept_dtype(dtype):
+    """The packed record type of `_REPORT_FIELDS` that ``dtype`` has."""
+    return np.dtype([(n, dtype.fields[n][0]) for n in _REPORT_FIELDS if n in dtype.names])
+
+
 def _kept_fields(records):
     """``records`` with only the fields of `_REPORT_FIELDS` it has, packed."""
-    kept = np.dtype([(n, records.dtype.fields[n][0]) for n in _REPORT_FIELDS if n in records.dtype.names])
+    kept = _kept_dtype(records.dtype)
     out = np.empty(records.shape, dtype=kept)
     for n in kept.names:
         out[n] = records[n]
