@@ -208,8 +208,8 @@ def run_fil(motion, duration_ticks, config=None, errors=None, seed=0, table=None
     seconds of wall time after the last one; always at the end) the firmware
     snapshot, the plant state, the noise generator's state and the number of
     records written go to ``checkpoint.json`` (temporary file + rename,
-    after the records are flushed to disk). With ``resume=True`` a run killed at any moment
-    continues from its last checkpoint: the records written after it are cut
+    after the records are flushed to disk). With ``resume=True`` a run
+    killed at any moment continues from its last checkpoint: the records written after it are cut
     off and recomputed, and the result is bit-identical to an uninterrupted
     run (with references too: which ones were pushed by a tick is a function
     of the tick, `Aider.seek`, and the firmware's snapshot holds its queue).
