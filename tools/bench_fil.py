@@ -4,6 +4,7 @@
     .venv/bin/python tools/bench_fil.py [--hours 72] [--json runs/bench/fil.json]
     .venv/bin/python tools/bench_fil.py --count [--hours 0.5] [--dump DIR]
     .venv/bin/python tools/bench_fil.py --dump DIR [--hours 0.5]
+    .venv/bin/python tools/bench_fil.py --schemes [--hours 6] [--rounds 5]
 
 1. A 10-minute closed-loop run (seed 002 experiment 1, flexible scheme,
    seed 002 sensor errors) three ways: compiled plant + C++ firmware
@@ -23,6 +24,11 @@
    build/host/fil_dump). fil_count's last lat_rad must equal the Python
    run_fil's bit for bit. ``--count`` alone runs only this and adds its
    figures to the existing JSON. ``--dump DIR`` alone only writes the inputs.
+4. (``--schemes``) where the closed loop's wall time goes: fil_count's own
+   timing of its one pyins_fil_run call (no Python around it) on the same
+   ship and sensors with the table at rest (scheme none), the traditional
+   and the flexible two-position scheme, timed in alternation: ns per tick
+   of each, the ratio to the table at rest and the share of ticks turning.
 """
 import argparse
 import inspect
@@ -49,21 +55,25 @@ BUILD = ROOT / "build" / "host"
 FIL_COUNT = BUILD / "fil_count"
 
 
-def the_case():
-    """The closed loop every part of this benchmark runs: (motion, errors, config, seed, every)."""
-    return sim.HeadingSwing.experiment(1), sim.preset("seed002"), dict(index_scheme=4), 1, 100
+def the_case(scheme=4):
+    """The closed loop every part of this benchmark runs: (motion, errors, config, seed, every);
+    ``scheme``: the indexing scheme (4, seed 002's flexible two-position; ``--schemes`` also
+    runs 0, none, and 2, the traditional two-position)."""
+    return sim.HeadingSwing.experiment(1), sim.preset("seed002"), dict(index_scheme=scheme), 1, 100
 
 
 # ---------------------------------------------------------------------------
 # 3. instruction counts: the inputs of one pyins_fil_run call, the C driver
 #    on them under callgrind
 
-def dump_inputs(out_dir, n):
+def dump_inputs(out_dir, n, scheme=4):
     """Write the inputs of pyins_fil_run over the first ``n`` ticks of the
-    case, built as run_fil builds them (one chunk of ``n`` ticks), to
-    ``out_dir`` (the files tools/fil_count.c reads), plus ``fil_dump.json``
-    with the sizes and the Python run_fil's final lat_rad. Returns that dict."""
-    m, errors, config, seed, every = the_case()
+    case (indexing ``scheme``), built as run_fil builds them (one chunk of
+    ``n`` ticks), to ``out_dir`` (the files tools/fil_count.c reads), plus
+    ``fil_dump.json`` with the sizes, the Python run_fil's final lat_rad and
+    the share of its kept records (every 100th tick) with the table turning.
+    Returns that dict."""
+    m, errors, config, seed, every = the_case(scheme)
     defaults = {k: v.default for k, v in inspect.signature(fil.run_fil).parameters.items()}
     dt, nodes = defaults["dt"], defaults["nodes"]
     # run_fil's step 1 (the loop's parts), as there
@@ -115,6 +125,7 @@ def dump_inputs(out_dir, n):
         "doubles": {k: int(np.asarray(v).size) for k, v in arrays.items()},
         "python_final_lat_rad": lat, "python_final_lat_rad_hex": lat.hex(),
         "python_final_tick": int(res.outputs["tick"][-1]),
+        "turning_share_sampled": float(np.mean(res.plant["rate_rad_s"] != 0.0)),
     }
     with open(os.path.join(out_dir, "fil_dump.json"), "w") as f:
         json.dump(info, f, indent=2)
@@ -166,6 +177,58 @@ def _inclusive(out_file, names):
         if sym in names and sym not in found:
             found[sym] = int(mt.group(1).replace(",", ""))
     return {k: found.get(k) for k in names}
+
+
+def _loop_s(stdout):
+    """fil_count's wall time of the pyins_fil_run call (its ``loop_s X``)."""
+    words = stdout.split()
+    return float(words[words.index("loop_s") + 1])
+
+
+#: --schemes: (indexing scheme, name), the table at rest first
+SCHEMES = ((0, "none (table at rest)"), (2, "traditional two-position"), (4, "flexible two-position"))
+
+
+def time_schemes(hours, rounds, dump_root):
+    """Section 4 (``--schemes``): the wall time of the closed loop alone, in C
+    (fil_count: one pyins_fil_run call, no Python around it), of the same
+    ship and sensors under three indexing schemes, timed in alternation
+    ``rounds`` times: what a tick costs with the table at rest and what its
+    turning ticks add. Figures dict."""
+    n = int(round(hours * 3600 * TICK_HZ))
+    subprocess.run(["cmake", "--build", str(BUILD), "--target", "fil_count"], check=True,
+                   capture_output=True, text=True)
+    print(f"the closed loop alone in C (fil_count), {hours:g} h ({n:,} ticks) under three schemes, "
+          f"{rounds} rounds; load {os.getloadavg()[0]:.2f}")
+    infos = {}
+    for scheme, _ in SCHEMES:
+        d = os.path.join(dump_root, f"scheme{scheme}")
+        infos[scheme] = dump_inputs(d, n, scheme)
+    times = {scheme: [] for scheme, _ in SCHEMES}
+    for r in range(rounds):
+        order = SCHEMES if r % 2 == 0 else SCHEMES[::-1]
+        for scheme, _ in order:
+            res = subprocess.run([str(FIL_COUNT), os.path.join(dump_root, f"scheme{scheme}")],
+                                 capture_output=True, text=True)
+            if res.returncode != 0:
+                raise SystemExit(f"FAIL: fil_count exited {res.returncode}: {res.stderr.strip()}")
+            _check_lat(f"fil_count, scheme {scheme}", res.stdout, infos[scheme])
+            times[scheme].append(_loop_s(res.stdout))
+    rest = float(np.median(times[0])) / n
+    fig = {"schemes_hours": hours, "schemes_rounds": rounds}
+    print(f"  {'scheme':26s} {'ns/tick':>8s} {'range':>15s} {'/ none':>7s} {'turning':>8s}")
+    for scheme, name in SCHEMES:
+        med = float(np.median(times[scheme])) / n
+        share = infos[scheme]["turning_share_sampled"]
+        fig[f"schemes_ns_per_tick_{scheme}"] = med * 1e9
+        fig[f"schemes_turning_share_{scheme}"] = share
+        lo, hi = min(times[scheme]) / n * 1e9, max(times[scheme]) / n * 1e9
+        print(f"  {name:26s} {med * 1e9:8.1f} {f'[{lo:.1f}, {hi:.1f}]':>15s} {med / rest:7.3f} "
+              f"{100 * share:7.2f}%")
+    print(f"  (median and range over the rounds; turning: the share of the kept records, every 100th "
+          f"tick, with the table's rate not 0; fil_count reproduced run_fil's final lat_rad bit for bit "
+          f"in every round; load {os.getloadavg()[0]:.2f} after)")
+    return fig
 
 
 def count_instructions(hours, dump_dir):
@@ -237,8 +300,25 @@ def main(argv=None):
                     help="only the callgrind instruction count (figures added to the JSON)")
     ap.add_argument("--dump", metavar="DIR", default=None,
                     help="where the inputs of fil_count go (alone: only write them)")
+    ap.add_argument("--schemes", action="store_true",
+                    help="only section 4: the closed loop alone in C under three indexing schemes "
+                         "(--hours default 6, --rounds; figures added to the JSON)")
+    ap.add_argument("--rounds", type=int, default=5, help="--schemes: timed rounds (default 5)")
     args = ap.parse_args(argv)
     dump_dir = args.dump or str(BUILD / "fil_dump")
+    if args.schemes:
+        if args.rounds < 1:
+            ap.error("--rounds must be at least 1")
+        hours = args.hours if args.hours is not None else 6.0
+        if not hours > 0:
+            ap.error("--hours must be > 0")
+        fig = {}
+        if os.path.exists(args.json):
+            with open(args.json) as f:
+                fig = json.load(f)
+        fig.update(time_schemes(hours, args.rounds, args.dump or str(BUILD / "fil_schemes")))
+        _write_json(args.json, fig)
+        return 0
     if args.count or args.dump:
         hours = args.hours if args.hours is not None else 0.5
         if not args.count:

@@ -15,11 +15,13 @@
  *                     sums of a table at rest (absent: summed per tick)
  * Calls pyins_fil_run once over all n ticks and prints the ticks done and
  * the last kept output's lat_rad (%.17g), which bench_fil.py compares with
- * the Python run's bit for bit. */
+ * the Python run's bit for bit, and the call's wall time (loop_s: the
+ * closed loop alone, no Python around it; meaningless under valgrind). */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "pyins_core.h"
 #include "pyins_plant.h"
@@ -94,6 +96,7 @@ int main(int argc, char **argv) {
     pyins_output *outputs;
     pyins_plant_record *records;
     int status;
+    struct timespec t0, t1;
     if (argc != 2) {
         fprintf(stderr, "usage: fil_count DIR   (DIR from tools/bench_fil.py --dump DIR)\n");
         return 2;
@@ -146,10 +149,12 @@ int main(int argc, char **argv) {
         fprintf(stderr, "fil_count: out of memory\n");
         return 2;
     }
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     status = pyins_fil_run((pyins_core *)mem, &st, &table, &err, omega, force, x, w, sum_omega, sum_force,
                            (int32_t)params[1],
                            params[0], params[4], g_noise, a_noise, n, dt, (size_t)params[2], outputs,
                            records, capacity, &n_done, &n_out);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
     if (status != PYINS_OK) {
         fprintf(stderr, "fil_count: pyins_fil_run returned %d after %zu ticks\n", status, n_done);
         return 4;
@@ -158,8 +163,8 @@ int main(int argc, char **argv) {
         fprintf(stderr, "fil_count: no output kept (n %zu < every %lld)\n", n, (long long)params[2]);
         return 4;
     }
-    printf("ticks %zu lat %.17g outputs %zu alpha %.17g\n", n_done, outputs[n_out - 1].lat_rad, n_out,
-           st.alpha_rad);
+    printf("ticks %zu lat %.17g outputs %zu alpha %.17g loop_s %.6f\n", n_done, outputs[n_out - 1].lat_rad,
+           n_out, st.alpha_rad, (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
     free(outputs);
     free(records);
     free(omega);
