@@ -27,14 +27,21 @@ grid point (a group of the campaign's points that differ only in the draw):
 A grid point whose table is steered by the firmware's heading
 (`pyins.budget.steered_table`) is marked ``steered``: there the budget
 uses the error-free unit's stops for every unit, an approximation whose
-error the checks measure (on seed 002's campaign: within 0.15 % to 3.1 %
-for the literal flexible scheme, up to 135 % for the derivation form).
+error the checks measure (on seed 002's campaign, docs/results/
+budget_montecarlo.md: every checked unit there turned its table otherwise,
+and differed by up to 8.0 % for the literal flexible scheme, up to 131 %
+for the derivation form).
 
-The checks: ``checks`` (grid point, draw) pairs picked at random (a fixed
-seed), each run in the closed loop with that draw's constants and no noise,
+The checks: ``checks`` distinct (grid point, draw) pairs picked at random
+without replacement (a fixed seed), each run in the closed loop with that draw's constants and no noise,
 against the budget's noise-free value. The figure is the final horizontal
 error; the budget gives no maximum over time with noise (the noise is a
-process, its covariance gives the final spread only).
+process, its covariance gives the final spread only). Each check also says
+whether its table turned as the error-free unit's (the same true table
+angle at every record tick both runs keep, the same motor starts and
+commanded travel at the end), and if not, from when: where it did, the
+budget used the unit's own table history and the difference is the
+model's; where it did not, the difference is the steering's.
 
 Refused (ValueError) where the budget's model does not hold
 (`pyins.budget.outside_model`: an alignment phase, external references,
@@ -56,6 +63,8 @@ __all__ = ["by_budget", "NOISE_SALT"]
 NOISE_SALT = 0xB0D6E7
 #: The seed of the checks' choice of (grid point, draw).
 CHECK_SEED = 20261206
+#: Checks when none are asked for (fewer if the campaign has fewer units to check).
+DEFAULT_CHECKS = 10
 
 
 def grid_points(camp):
@@ -73,8 +82,32 @@ def _scenario(camp, point, every=None):
     return camp.base.with_overrides(over)
 
 
+def _table_history(res):
+    """What says whether two runs turned their tables alike: the plant's
+    record ticks and true table angles, and the final record's motor
+    starts and commanded travel (which count every move, between records
+    too)."""
+    last = res.outputs[-1]
+    return {"tick": np.asarray(res.plant["tick"]), "alpha": np.asarray(res.plant["alpha_rad"]),
+            "starts": int(last["index_motor_starts"]), "travel": float(last["index_travel_rad"])}
+
+
+def same_table(model, check, dt):
+    """(same, first_s): whether a check's table turned as the error-free
+    unit's, bit for bit at every record tick both runs keep and in motor
+    starts and travel at the end; first_s, the first such tick's time [s]
+    where the angles differ (None if none does, or if only the end's counts
+    differ)."""
+    common, i, j = np.intersect1d(model["tick"], check["tick"], assume_unique=True, return_indices=True)
+    differ = model["alpha"][i] != check["alpha"][j]
+    first = float(common[np.argmax(differ)]) * dt if differ.any() else None
+    same = first is None and model["starts"] == check["starts"] and model["travel"] == check["travel"]
+    return same, first
+
+
 def _model(task):
-    """Steps 1 and 2 for one grid point (a worker's task): the final states."""
+    """Steps 1 and 2 for one grid point (a worker's task): the final states
+    and the error-free unit's table history."""
     scn, preset = task
     t0 = time.perf_counter()
     (spec,) = list(scn.runs())
@@ -87,17 +120,18 @@ def _model(task):
     init = final[len(basis)] if b.names[-1] == budget.INITIAL else np.zeros(7)
     cov = b.noise_position_cov()[-1] if b.noise_cov is not None else np.zeros((2, 2))
     return {"final": final[:len(basis)], "initial": init, "noise_cov": cov, "scale": b.position_scale(),
-            "seconds": time.perf_counter() - t0}
+            "table": _table_history(res), "dt": spec.dt, "seconds": time.perf_counter() - t0}
 
 
 def _check(task):
-    """One closed-loop check (a worker's task): final horizontal error [m] without noise."""
+    """One closed-loop check (a worker's task): final horizontal error [m]
+    without noise, its table history (`_table_history`) and its seconds."""
     scn = task
     t0 = time.perf_counter()
     (spec,) = list(scn.runs())
     res = fil.run_fil(spec.motion, spec.duration_ticks, config=spec.config,
                       errors=budget.deterministic(spec.errors), table=spec.table, every=spec.every)
-    return float(metrics.nav_errors(res).horizontal_m[-1]), time.perf_counter() - t0
+    return float(metrics.nav_errors(res).horizontal_m[-1]), _table_history(res), time.perf_counter() - t0
 
 
 def coefficients(preset, draws):
@@ -122,15 +156,20 @@ def final_errors(model, coef, noise=True, first_draw=0):
 
 def by_budget(camp, draws, checks=0, workers=None, log=None):
     """Place ``draws`` draws of ``camp``'s random constants through the
-    budget at every grid point, and run ``checks`` closed-loop checks.
+    budget at every grid point, and run ``checks`` closed-loop checks
+    (None: `DEFAULT_CHECKS`, or every (grid point, draw) pair if fewer;
+    more than there are pairs is refused).
     Returns {"points": [{values, draws, final_m (draws,), final_clean_m,
     seconds_model}], "checks": [{values, draw, closed_loop_m, budget_m, rel,
-    seconds}], "seconds_budget", "seconds_checks", "workers"}."""
+    same_table, table_differs_from_s, seconds}], "seconds_budget",
+    "seconds_checks", "workers"}: ``same_table`` says whether the check's
+    table turned as the error-free unit's whose history the budget took
+    (`same_table`), ``table_differs_from_s`` from when it did not."""
     preset = camp.random_constants
     if not preset:
         raise ValueError(f"campaign {camp.name!r} draws no random constants (campaign.random_constants): "
                          "the budget has nothing to place")
-    if draws < 1 or checks < 0:
+    if draws < 1 or (checks is not None and checks < 0):
         raise ValueError(f"draws must be >= 1 and checks >= 0, got {draws} and {checks}")
     workers = workers or os.cpu_count()
     say = log or (lambda text: None)
@@ -142,6 +181,13 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
         if refusal is not None:
             raise ValueError(f"{dict(values)}: {refusal}")
         steered.append(budget.steered_table(spec))
+    pairs = [(i, p) for i, (_, group) in enumerate(pts) for p in group[:min(draws, len(group))]]
+    if checks is None:
+        checks = min(DEFAULT_CHECKS, len(pairs))
+    elif checks > len(pairs):
+        raise ValueError(f"{checks} checks asked, but there are only {len(pairs)} (grid point, draw) pairs to "
+                         f"check (the campaign's units among the first {draws} draws at its {len(pts)} grid "
+                         f"point(s)): ask for {len(pairs)} or fewer")
     t0 = time.perf_counter()
     say(f"the budget: {len(pts)} grid point(s), one error-free closed-loop run and one budget each")
     tasks = [(_scenario(camp, group[0], every="1 s"), preset) for _, group in pts]
@@ -163,23 +209,23 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
                            "seconds_model": model["seconds"]})
     t_budget = time.perf_counter() - t0
     say(f"  {draws:,} draws x {len(pts)} grid point(s) through the budget in {t_budget:.0f} s")
-    rng = np.random.default_rng(CHECK_SEED)
-    picks = []
-    for _ in range(checks):
-        i = int(rng.integers(len(pts)))
-        group = pts[i][1]
-        picks.append((i, group[int(rng.integers(min(draws, len(group))))]))
+    # the checks: distinct (grid point, draw) pairs, picked at random without replacement
+    picks = [pairs[k] for k in np.random.default_rng(CHECK_SEED).choice(len(pairs), size=checks, replace=False)]
     t1 = time.perf_counter()
     out_checks = []
     if picks:
         with concurrent.futures.ProcessPoolExecutor(min(workers, len(picks))) as ex:
-            for (i, p), (loop, sec) in zip(picks, ex.map(_check, [_scenario(camp, p) for _, p in picks])):
+            for (i, p), (loop, table, sec) in zip(picks, ex.map(_check, [_scenario(camp, p) for _, p in picks])):
                 bud = float(out_points[i]["final_clean_m"][p.run])
+                same, first = same_table(models[i]["table"], table, models[i]["dt"])
                 out_checks.append({"values": dict(pts[i][0]), "point": i, "draw": p.run, "closed_loop_m": loop,
-                                   "budget_m": bud, "rel": (bud - loop) / loop, "seconds": sec})
+                                   "budget_m": bud, "rel": (bud - loop) / loop, "same_table": same,
+                                   "table_differs_from_s": first, "seconds": sec})
                 left = (time.perf_counter() - t1) / len(out_checks) * (len(picks) - len(out_checks))
                 say(f"  check {len(out_checks)}/{len(picks)}: {dict(pts[i][0])}, draw {p.run}: closed loop "
                     f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)"
+                    + ("" if same else f"; its table turned otherwise than the error-free unit's"
+                       + ("" if first is None else f" from {first / 3600:.2f} h"))
                     + (f"; about {left:.0f} s left" if len(out_checks) < len(picks) else ""))
     return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
             "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset}

@@ -41,8 +41,8 @@ def add_campaign(cmd):
                         "(one closed-loop run per grid point) instead of a closed-loop run per draw; "
                         "writes OUT/budget.md and budget.json")
     p.add_argument("--checks", type=int, metavar="M",
-                   help="with --budget: M closed-loop runs of (grid point, draw) picked at random, "
-                        "held against the budget (default 10)")
+                   help="with --budget: M closed-loop runs of distinct (grid point, draw) pairs picked "
+                        "at random, held against the budget (default 10, or every pair if fewer)")
 
 
 def add_budget(cmd):
@@ -171,12 +171,13 @@ def cmd_campaign(args):
 def _campaign_by_budget(args, camp, out):
     """`pyins campaign --budget N`: the draws through the error budget
     (`pyins.campaign.by_budget`), OUT/budget.json and budget.md."""
-    checks = 10 if args.checks is None else args.checks
+    checks = args.checks       # None: by_budget's default (10, or every unit if fewer)
     if not camp.random_constants:
         raise InputError(f"campaign --budget: campaign {camp.name!r} draws no random constants "
                          f"(campaign.random_constants): the budget has nothing to place")
     say(args, f"pyins campaign {camp.name} --budget {args.budget} -> {out}: {args.budget:,} draws through the "
-              f"error budget, {checks} closed-loop check(s)")
+              f"error budget, {'10 (or every unit if fewer)' if checks is None else checks} closed-loop "
+              f"check(s)")
     try:
         res = by_budget(camp, args.budget, checks, args.workers, log=lambda text: say(args, text))
     except ValueError as exc:
@@ -191,9 +192,14 @@ def _campaign_by_budget(args, camp, out):
                         f"unit's, an approximation; the checks measure its error there")
     bad = [c for c in res["checks"] if abs(c["rel"]) > 0.01]
     if bad:
+        own = [c for c in bad if c["same_table"]]
         warnings.append(f"{len(bad)} of {len(res['checks'])} check(s) differ from the closed loop by more than "
-                        f"1 % (largest {100 * max(abs(c['rel']) for c in bad):.2f} %): the budget is an "
-                        f"approximation there (a table steered by the unit's own heading)")
+                        f"1 % (largest {100 * max(abs(c['rel']) for c in bad):.2f} %): "
+                        + (f"in all of them the unit's table turned otherwise than the error-free unit's, "
+                           f"whose stops the budget takes (a table steered by the unit's own heading)"
+                           if not own else
+                           f"{len(own)} of them with the error-free unit's table history, so the budget's "
+                           f"own model misses there"))
     lines = [f"# {camp.name}: {args.budget:,} draws through the error budget", "",
              f"Final horizontal error; the budget's draws with the noise drawn from its covariance "
              f"(`pyins.campaign.by_budget`). {res['seconds_budget']:.0f} s for the budget, "
@@ -215,11 +221,14 @@ def _campaign_by_budget(args, camp, out):
                        "median_m": float(np.median(v)),
                        "p5_m": float(np.percentile(v, 5)), "p95_m": float(np.percentile(v, 95)),
                        "final_m": [float(x) for x in v]})
-    lines += ["", "| grid point | draw | closed loop (no noise) | budget (no noise) | difference |", "|---|---|---|---|---|"]
+    lines += ["", "| grid point | draw | closed loop (no noise) | budget (no noise) | difference | "
+              "table turned as the error-free unit's |", "|---|---|---|---|---|---|"]
     for c in res["checks"]:
         label = ", ".join(f"{k}={x}" for k, x in c["values"].items())
+        table = ("yes" if c["same_table"] else "no" if c["table_differs_from_s"] is None
+                 else f"no, from {c['table_differs_from_s'] / 3600:.2f} h")
         lines.append(f"| {label} | {c['draw']} | {c['closed_loop_m']:.1f} m | {c['budget_m']:.1f} m | "
-                     f"{100 * c['rel']:+.3f} % |")
+                     f"{100 * c['rel']:+.3f} % | {table} |")
     if warnings:
         lines += ["", *[f"**Warning:** {w}" for w in warnings]]
     os.makedirs(out, exist_ok=True)
