@@ -276,6 +276,14 @@ record_every = "60 s"
 """
 
 
+def _seed002_budget_campaign(schemes, duration):
+    """BUDGET_CAMPAIGN on seed 002's experiment 1 and its draws, over the
+    schemes (a TOML list) for the duration."""
+    return (BUDGET_CAMPAIGN.replace('scenario = "seed003"', 'scenario = "seed002_exp1"')
+            .replace('random_constants = "seed003"', 'random_constants = "seed002"')
+            .replace('["none", "single_position"]', schemes).replace('"2 h"', f'"{duration}"'))
+
+
 def test_campaign_budget_places_draws_held_to_the_closed_loop(tmp_path, capsys):
     """`pyins campaign FILE --budget 300 --checks 3`: 300 draws per grid
     point through the budget, and three closed-loop runs of drawn units (no
@@ -355,10 +363,7 @@ def test_campaign_budget_checks_say_where_the_units_stops_moved(tmp_path, capsys
     when; a check that misses by more than 1 % is put down to that."""
     from pyins import __main__ as cli
     f = tmp_path / "c.toml"
-    f.write_text(BUDGET_CAMPAIGN.replace('scenario = "seed003"', 'scenario = "seed002_exp1"')
-                 .replace('random_constants = "seed003"', 'random_constants = "seed002"')
-                 .replace('["none", "single_position"]', '["flexible_derived"]')
-                 .replace('"2 h"', '"6 h"'))
+    f.write_text(_seed002_budget_campaign('["flexible_derived"]', "6 h"))
     out = tmp_path / "out"
     assert cli.main(["campaign", str(f), "--budget", "20", "--checks", "4", "--workers", "2",
                      "--out", str(out)]) == 0
@@ -398,10 +403,7 @@ def test_campaign_budget_warns_where_the_table_is_steered(tmp_path, capsys):
     from pyins import __main__ as cli
     from pyins.budget import steered_table
     f = tmp_path / "c.toml"
-    f.write_text(BUDGET_CAMPAIGN.replace('scenario = "seed003"', 'scenario = "seed002_exp1"')
-                 .replace('random_constants = "seed003"', 'random_constants = "seed002"')
-                 .replace('["none", "single_position"]', '["two_position", "flexible"]')
-                 .replace('"2 h"', '"1 h"'))
+    f.write_text(_seed002_budget_campaign('["two_position", "flexible"]', "1 h"))
     out = tmp_path / "out"
     assert cli.main(["campaign", str(f), "--budget", "20", "--checks", "0", "--out", str(out)]) == 0
     err = capsys.readouterr().err
