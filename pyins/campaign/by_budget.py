@@ -50,6 +50,7 @@ random constants.
 """
 import concurrent.futures
 import os
+import signal
 import time
 
 import numpy as np
@@ -57,7 +58,7 @@ import numpy as np
 from pyins import budget, fil, metrics
 from pyins.sim import sensors
 
-__all__ = ["by_budget", "NOISE_SALT"]
+__all__ = ["by_budget", "BudgetInterrupted", "NOISE_SALT"]
 
 #: The noise draws' generator: seed (NOISE_SALT, draw), apart from every other stream.
 NOISE_SALT = 0xB0D6E7
@@ -65,6 +66,22 @@ NOISE_SALT = 0xB0D6E7
 CHECK_SEED = 20261206
 #: Checks when none are asked for (fewer if the campaign has fewer units to check).
 DEFAULT_CHECKS = 10
+
+
+class BudgetInterrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) during the checks: ``.result`` is what `by_budget`
+    returns, with every draw placed and the checks that had finished, and
+    ``"interrupted": True``."""
+
+    def __init__(self, result):
+        super().__init__(f"interrupted after {len(result['checks'])} of {result['checks_planned']} checks")
+        self.result = result
+
+
+def _worker_init():
+    """A pool worker leaves SIGINT to the parent, which stops the pool and
+    keeps what has finished (a Ctrl-C at the terminal reaches the workers too)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def grid_points(camp):
@@ -192,7 +209,7 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
     say(f"the budget: {len(pts)} grid point(s), one error-free closed-loop run and one budget each")
     tasks = [(_scenario(camp, group[0], every="1 s"), preset) for _, group in pts]
     models = [None] * len(tasks)
-    with concurrent.futures.ProcessPoolExecutor(min(workers, len(tasks))) as ex:
+    with concurrent.futures.ProcessPoolExecutor(min(workers, len(tasks)), initializer=_worker_init) as ex:
         futures = {ex.submit(_model, task): i for i, task in enumerate(tasks)}
         for done, fut in enumerate(concurrent.futures.as_completed(futures), start=1):
             i = futures[fut]
@@ -213,19 +230,38 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
     picks = [pairs[k] for k in np.random.default_rng(CHECK_SEED).choice(len(pairs), size=checks, replace=False)]
     t1 = time.perf_counter()
     out_checks = []
+
+    def result(interrupted=False):
+        return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
+                "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset,
+                "checks_planned": len(picks), "interrupted": interrupted}
     if picks:
-        with concurrent.futures.ProcessPoolExecutor(min(workers, len(picks))) as ex:
+        try:
+            _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers)
+        except KeyboardInterrupt:
+            raise BudgetInterrupted(result(interrupted=True)) from None
+    return result()
+
+
+def _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers):
+    """The closed-loop checks, appended to ``out_checks`` as they finish (in
+    the picks' order). Ctrl-C: no further check starts, the ones running end,
+    KeyboardInterrupt."""
+    with concurrent.futures.ProcessPoolExecutor(min(workers, len(picks)), initializer=_worker_init) as ex:
+        try:
             for (i, p), (loop, table, sec) in zip(picks, ex.map(_check, [_scenario(camp, p) for _, p in picks])):
+                values = out_points[i]["values"]
                 bud = float(out_points[i]["final_clean_m"][p.run])
                 same, first = same_table(models[i]["table"], table, models[i]["dt"])
-                out_checks.append({"values": dict(pts[i][0]), "point": i, "draw": p.run, "closed_loop_m": loop,
+                out_checks.append({"values": dict(values), "point": i, "draw": p.run, "closed_loop_m": loop,
                                    "budget_m": bud, "rel": (bud - loop) / loop, "same_table": same,
                                    "table_differs_from_s": first, "seconds": sec})
                 left = (time.perf_counter() - t1) / len(out_checks) * (len(picks) - len(out_checks))
-                say(f"  check {len(out_checks)}/{len(picks)}: {dict(pts[i][0])}, draw {p.run}: closed loop "
+                say(f"  check {len(out_checks)}/{len(picks)}: {values}, draw {p.run}: closed loop "
                     f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)"
                     + ("" if same else f"; its table turned otherwise than the error-free unit's"
                        + ("" if first is None else f" from {first / 3600:.2f} h"))
                     + (f"; about {left:.0f} s left" if len(out_checks) < len(picks) else ""))
-    return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
-            "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset}
+        except KeyboardInterrupt:
+            ex.shutdown(wait=True, cancel_futures=True)
+            raise

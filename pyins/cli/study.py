@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from pyins import budget, campaign, records, scenario
-from pyins.campaign.by_budget import by_budget
+from pyins.campaign.by_budget import BudgetInterrupted, by_budget
 from pyins.metrics import display
 from pyins.units import NMI_TO_M
 
@@ -182,7 +182,13 @@ def _campaign_by_budget(args, camp, out):
         res = by_budget(camp, args.budget, checks, args.workers, log=lambda text: say(args, text))
     except ValueError as exc:
         raise InputError(f"campaign --budget: {exc}") from None
+    except BudgetInterrupted as stop:       # Ctrl-C in the checks: the draws and the checks done are kept
+        res = stop.result
     warnings = []
+    if res["interrupted"]:
+        warnings.append(f"interrupted (Ctrl-C) after {len(res['checks'])} of {res['checks_planned']} closed-loop "
+                        f"checks: the draws are all placed, the checks are incomplete; run the command again "
+                        f"for all of them")
     if not res["checks"]:
         warnings.append("no closed-loop check: the budget's figures are not held to the firmware in this run")
     steered = [", ".join(f"{k}={x}" for k, x in pt["values"].items()) for pt in res["points"] if pt["steered"]]
@@ -201,6 +207,8 @@ def _campaign_by_budget(args, camp, out):
                            f"{len(own)} of them with the error-free unit's table history, so the budget's "
                            f"own model misses there"))
     lines = [f"# {camp.name}: {args.budget:,} draws through the error budget", "",
+             *([f"**Incomplete:** interrupted after {len(res['checks'])} of {res['checks_planned']} "
+                f"closed-loop checks.", ""] if res["interrupted"] else []),
              f"Final horizontal error; the budget's draws with the noise drawn from its covariance "
              f"(`pyins.campaign.by_budget`). {res['seconds_budget']:.0f} s for the budget, "
              f"{res['seconds_checks']:.0f} s for {len(res['checks'])} closed-loop check(s), "
@@ -233,7 +241,8 @@ def _campaign_by_budget(args, camp, out):
         lines += ["", *[f"**Warning:** {w}" for w in warnings]]
     os.makedirs(out, exist_ok=True)
     records.write_atomic(os.path.join(out, "budget.md"), "\n".join(lines) + "\n")
-    blob = {"campaign": camp.name, "draws": args.budget, "points": points,
+    blob = {"campaign": camp.name, "draws": args.budget, "complete": not res["interrupted"],
+            "checks_planned": res["checks_planned"], "points": points,
             "checks": [{k: v for k, v in c.items() if k != "point"} for c in res["checks"]],
             "seconds_budget": res["seconds_budget"], "seconds_checks": res["seconds_checks"],
             "workers": res["workers"], "warnings": warnings}
@@ -242,7 +251,7 @@ def _campaign_by_budget(args, camp, out):
         print(f"pyins campaign: warning: {w}", file=sys.stderr)
     say(args, f"  report: {os.path.join(out, 'budget.md')}")
     emit_json(args, blob)
-    return EXIT_OK
+    return EXIT_INTERRUPTED if res["interrupted"] else EXIT_OK
 
 
 def cmd_budget(args):

@@ -15,6 +15,7 @@ from pyins import campaign, scenario
 from pyins.scenario import ScenarioError
 from pyins.sim import sensors
 from pyins.units import ARCSEC_TO_RAD, DPH_TO_RPS, UG_TO_MPS2
+from budget_campaign import BUDGET_CAMPAIGN
 from tools_loader import load_tool
 
 
@@ -261,21 +262,6 @@ def test_one_seeds_report_keeps_the_others_figures(tmp_path):
 # ---------------------------------------------------------------------------
 # The draws through the error budget (`pyins campaign --budget`)
 # ---------------------------------------------------------------------------
-BUDGET_CAMPAIGN = """
-[campaign]
-scenario = "seed003"
-seeds = 4
-random_constants = "seed003"
-group_by = ["indexing.scheme"]
-compare = "drop"
-[campaign.grid]
-"indexing.scheme" = ["none", "single_position"]
-[campaign.set]
-duration = "2 h"
-record_every = "60 s"
-"""
-
-
 def _seed002_budget_campaign(schemes, duration):
     """BUDGET_CAMPAIGN on seed 002's experiment 1 and its draws, over the
     schemes (a TOML list) for the duration."""

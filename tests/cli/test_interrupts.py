@@ -21,6 +21,8 @@ from pyins import __main__ as cli
 from pyins import rundir, scenario
 from pyins.records import PLANT_RECORD_DTYPE
 
+from budget_campaign import BUDGET_CAMPAIGN
+
 #: How long after SIGINT a command may take to exit. The brief is "a second
 #: or two"; 5 s leaves room for a machine shared with other jobs (the stop
 #: itself is a summary write, measured at 0.1-1.1 s); the defect was > 60 s
@@ -308,3 +310,36 @@ def test_a_run_killed_as_it_began_is_started_again_and_a_users_file_is_kept(tmp_
     (d / "scenario.toml").unlink()
     (d / "resolved_scenario.json").write_text(scn.resolved_json())
     assert rundir.check_run_dir(scn, str(d)) == "same"
+
+
+
+def test_ctrl_c_in_the_budgets_checks_keeps_the_draws_and_the_checks_done(tmp_path):
+    """`pyins campaign --budget N --checks M` stopped by Ctrl-C once its
+    first check has finished: within seconds, exit 130, and budget.md /
+    budget.json written with every draw placed, the checks that finished,
+    "complete": false and the interruption as a kept warning (before, the
+    draws and the checks done were lost)."""
+    f = tmp_path / "c.toml"
+    f.write_text(BUDGET_CAMPAIGN.replace('"2 h"', '"24 h"'))      # checks of about a second each
+    out = tmp_path / "out"
+    proc = _start("campaign", str(f), "--budget", "200", "--checks", "8", "--workers", "2", "--out", str(out))
+    t0 = time.monotonic()
+    while True:                          # the first check's line on the terminal
+        line = proc.stdout.readline()
+        if not line:
+            pytest.fail(f"ended (rc {proc.wait()}) before a check finished: {proc.stderr.read()}")
+        if "check 1/8" in line:
+            break
+        if time.monotonic() - t0 > WAIT_S:
+            proc.kill()
+            pytest.fail(f"no check after {WAIT_S} s")
+    rc, err, seconds = _stop(proc)
+    assert rc == 130 and seconds < STOP_S, (rc, seconds, err)
+    res = _json(out / "budget.json")
+    assert res is not None and res["complete"] is False and res["checks_planned"] == 8
+    assert 1 <= len(res["checks"]) < 8, len(res["checks"])
+    assert all(len(p["final_m"]) == 200 for p in res["points"])
+    assert any("interrupted (Ctrl-C) after" in w for w in res["warnings"])
+    assert "interrupted (Ctrl-C) after" in err
+    assert "**Incomplete:** interrupted after" in (out / "budget.md").read_text()
+    assert _group_gone(proc.pid)
