@@ -171,11 +171,16 @@ def final_errors(model, coef, noise=True, first_draw=0):
     return ne
 
 
-def by_budget(camp, draws, checks=0, workers=None, log=None):
+def by_budget(camp, draws, checks=0, workers=None, log=None, kept=None, on_check=None):
     """Place ``draws`` draws of ``camp``'s random constants through the
     budget at every grid point, and run ``checks`` closed-loop checks
     (None: `DEFAULT_CHECKS`, or every (grid point, draw) pair if fewer;
-    more than there are pairs is refused).
+    more than there are pairs is refused). ``kept``: (checks planned, the
+    checks done) of an earlier call on the same campaign and draws, stopped
+    part-way: those that are the first of this call's picks (the same
+    count planned, the same pairs in the same order: the picks are seeded)
+    are taken as done, not run again. ``on_check(checks, planned)`` is
+    called after every check that finishes (to save them as they come).
     Returns {"points": [{values, draws, final_m (draws,), final_clean_m,
     seconds_model}], "checks": [{values, draw, closed_loop_m, budget_m, rel,
     same_table, table_differs_from_s, seconds}], "seconds_budget",
@@ -230,37 +235,50 @@ def by_budget(camp, draws, checks=0, workers=None, log=None):
     picks = [pairs[k] for k in np.random.default_rng(CHECK_SEED).choice(len(pairs), size=checks, replace=False)]
     t1 = time.perf_counter()
     out_checks = []
+    if kept is not None and kept[0] == len(picks):
+        for c, (i, p) in zip(kept[1], picks):
+            if c.get("draw") != p.run or c.get("values") != out_points[i]["values"]:
+                break
+            bud = float(out_points[i]["final_clean_m"][p.run])   # the budget's, as it is now (the same bits)
+            out_checks.append({**c, "point": i, "budget_m": bud,
+                               "rel": (bud - c["closed_loop_m"]) / c["closed_loop_m"]})
+        if out_checks:
+            say(f"  {len(out_checks)} of {len(picks)} check(s) kept from the run that stopped")
 
     def result(interrupted=False):
         return {"points": out_points, "checks": out_checks, "seconds_budget": t_budget,
                 "seconds_checks": time.perf_counter() - t1, "workers": workers, "preset": preset,
                 "checks_planned": len(picks), "interrupted": interrupted}
-    if picks:
+    if len(out_checks) < len(picks):
         try:
-            _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers)
+            _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers, on_check)
         except KeyboardInterrupt:
             raise BudgetInterrupted(result(interrupted=True)) from None
     return result()
 
 
-def _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers):
-    """The closed-loop checks, appended to ``out_checks`` as they finish (in
-    the picks' order). Ctrl-C: no further check starts, the ones running end,
-    KeyboardInterrupt."""
-    with concurrent.futures.ProcessPoolExecutor(min(workers, len(picks)), initializer=_worker_init) as ex:
+def _run_checks(camp, picks, models, out_points, out_checks, t1, say, workers, on_check):
+    """The closed-loop checks not yet in ``out_checks``, appended as they
+    finish (in the picks' order; ``on_check`` after each). Ctrl-C: no
+    further check starts, the ones running end, KeyboardInterrupt."""
+    first = len(out_checks)
+    todo = picks[first:]
+    with concurrent.futures.ProcessPoolExecutor(min(workers, len(todo)), initializer=_worker_init) as ex:
         try:
-            for (i, p), (loop, table, sec) in zip(picks, ex.map(_check, [_scenario(camp, p) for _, p in picks])):
+            for (i, p), (loop, table, sec) in zip(todo, ex.map(_check, [_scenario(camp, p) for _, p in todo])):
                 values = out_points[i]["values"]
                 bud = float(out_points[i]["final_clean_m"][p.run])
-                same, first = same_table(models[i]["table"], table, models[i]["dt"])
+                same, since = same_table(models[i]["table"], table, models[i]["dt"])
                 out_checks.append({"values": dict(values), "point": i, "draw": p.run, "closed_loop_m": loop,
                                    "budget_m": bud, "rel": (bud - loop) / loop, "same_table": same,
-                                   "table_differs_from_s": first, "seconds": sec})
-                left = (time.perf_counter() - t1) / len(out_checks) * (len(picks) - len(out_checks))
+                                   "table_differs_from_s": since, "seconds": sec})
+                if on_check is not None:
+                    on_check(out_checks, len(picks))
+                left = (time.perf_counter() - t1) / (len(out_checks) - first) * (len(picks) - len(out_checks))
                 say(f"  check {len(out_checks)}/{len(picks)}: {values}, draw {p.run}: closed loop "
                     f"{loop:.1f} m, budget {bud:.1f} m ({100 * (bud - loop) / loop:+.3f} %)"
                     + ("" if same else f"; its table turned otherwise than the error-free unit's"
-                       + ("" if first is None else f" from {first / 3600:.2f} h"))
+                       + ("" if since is None else f" from {since / 3600:.2f} h"))
                     + (f"; about {left:.0f} s left" if len(out_checks) < len(picks) else ""))
         except KeyboardInterrupt:
             ex.shutdown(wait=True, cancel_futures=True)

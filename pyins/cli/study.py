@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from pyins import budget, campaign, records, scenario
-from pyins.campaign.by_budget import BudgetInterrupted, by_budget
+from pyins.campaign.by_budget import CHECK_SEED, BudgetInterrupted, by_budget
 from pyins.metrics import display
 from pyins.units import NMI_TO_M
 
@@ -168,6 +168,10 @@ def cmd_campaign(args):
     return EXIT_OK
 
 
+#: The checks of `pyins campaign --budget` done so far (a stopped run's, for the next to resume).
+BUDGET_CHECKS = "budget_checks.json"
+
+
 def _campaign_by_budget(args, camp, out):
     """`pyins campaign --budget N`: the draws through the error budget
     (`pyins.campaign.by_budget`), OUT/budget.json and budget.md."""
@@ -178,17 +182,38 @@ def _campaign_by_budget(args, camp, out):
     say(args, f"pyins campaign {camp.name} --budget {args.budget} -> {out}: {args.budget:,} draws through the "
               f"error budget, {'10 (or every unit if fewer)' if checks is None else checks} closed-loop "
               f"check(s)")
+    # the checks done by a run of the same campaign and draws that was stopped (Ctrl-C, a kill):
+    # OUT/budget_checks.json, written after every check, removed once all are done
+    done_path = os.path.join(out, BUDGET_CHECKS)
+    identity = {"campaign_digest": camp.digest(), "draws": args.budget, "check_seed": CHECK_SEED}
+    kept = None
     try:
-        res = by_budget(camp, args.budget, checks, args.workers, log=lambda text: say(args, text))
+        with open(done_path) as f:
+            done = json.load(f)
+        if all(done.get(k) == v for k, v in identity.items()):
+            kept = (done["checks_planned"], done["checks"])
+    except (OSError, ValueError, KeyError, TypeError):
+        kept = None                     # none, unreadable or another run's: the checks start over
+
+    def save(checks_done, planned):
+        os.makedirs(out, exist_ok=True)
+        records.write_atomic(done_path, json.dumps({**identity, "checks_planned": planned, "checks": [
+            {k: v for k, v in c.items() if k != "point"} for c in checks_done]}))
+    try:
+        res = by_budget(camp, args.budget, checks, args.workers, log=lambda text: say(args, text), kept=kept,
+                        on_check=save)
     except ValueError as exc:
         raise InputError(f"campaign --budget: {exc}") from None
     except BudgetInterrupted as stop:       # Ctrl-C in the checks: the draws and the checks done are kept
         res = stop.result
+        save(res["checks"], res["checks_planned"])  # (the Ctrl-C may have come between a check and its save)
     warnings = []
     if res["interrupted"]:
         warnings.append(f"interrupted (Ctrl-C) after {len(res['checks'])} of {res['checks_planned']} closed-loop "
-                        f"checks: the draws are all placed, the checks are incomplete; run the command again "
-                        f"for all of them")
+                        f"checks: the draws are all placed, the checks are incomplete; the same command "
+                        f"again runs the others (the checks done are kept in {BUDGET_CHECKS})")
+    elif os.path.exists(done_path):
+        os.remove(done_path)
     if not res["checks"]:
         warnings.append("no closed-loop check: the budget's figures are not held to the firmware in this run")
     steered = [", ".join(f"{k}={x}" for k, x in pt["values"].items()) for pt in res["points"] if pt["steered"]]

@@ -313,26 +313,48 @@ def test_a_run_killed_as_it_began_is_started_again_and_a_users_file_is_kept(tmp_
 
 
 
-def test_ctrl_c_in_the_budgets_checks_keeps_the_draws_and_the_checks_done(tmp_path):
-    """`pyins campaign --budget N --checks M` stopped by Ctrl-C once its
-    first check has finished: within seconds, exit 130, and budget.md /
-    budget.json written with every draw placed, the checks that finished,
-    "complete": false and the interruption as a kept warning (before, the
-    draws and the checks done were lost)."""
+def _budget_at_its_first_check(tmp_path):
+    """(campaign file, OUT, process): `pyins campaign --budget 200 --checks 8`
+    started, once the first check's line is on its terminal."""
     f = tmp_path / "c.toml"
     f.write_text(BUDGET_CAMPAIGN.replace('"2 h"', '"24 h"'))      # checks of about a second each
     out = tmp_path / "out"
     proc = _start("campaign", str(f), "--budget", "200", "--checks", "8", "--workers", "2", "--out", str(out))
     t0 = time.monotonic()
-    while True:                          # the first check's line on the terminal
+    while True:
         line = proc.stdout.readline()
         if not line:
             pytest.fail(f"ended (rc {proc.wait()}) before a check finished: {proc.stderr.read()}")
         if "check 1/8" in line:
-            break
+            return f, out, proc
         if time.monotonic() - t0 > WAIT_S:
             proc.kill()
             pytest.fail(f"no check after {WAIT_S} s")
+
+
+def test_a_budget_killed_in_its_checks_resumes_them(tmp_path, capsys):
+    """kill -9 in the checks: no budget.md, but the checks done are on disk
+    (budget_checks.json, written after each) and the same command keeps
+    them."""
+    f, out, proc = _budget_at_its_first_check(tmp_path)
+    rc, _, _ = _stop(proc, signal.SIGKILL)
+    assert rc == -signal.SIGKILL and not (out / "budget.md").exists()
+    done = _json(out / "budget_checks.json")
+    assert done is not None and 1 <= len(done["checks"]) < 8
+    assert cli.main(["campaign", str(f), "--budget", "200", "--checks", "8", "--out", str(out)]) == 0
+    assert f"{len(done['checks'])} of 8 check(s) kept from the run that stopped" in capsys.readouterr().out
+    assert _json(out / "budget.json")["complete"] is True and not (out / "budget_checks.json").exists()
+
+
+def test_ctrl_c_in_the_budgets_checks_keeps_the_draws_and_the_checks_done(tmp_path, capsys):
+    """`pyins campaign --budget N --checks M` stopped by Ctrl-C once its
+    first check has finished: within seconds, exit 130, and budget.md /
+    budget.json written with every draw placed, the checks that finished,
+    "complete": false and the interruption as a kept warning (before, the
+    draws and the checks done were lost). The same command again keeps the
+    checks done (budget_checks.json) and runs the others: the same
+    figures as a run never stopped."""
+    f, out, proc = _budget_at_its_first_check(tmp_path)
     rc, err, seconds = _stop(proc)
     assert rc == 130 and seconds < STOP_S, (rc, seconds, err)
     res = _json(out / "budget.json")
@@ -343,3 +365,18 @@ def test_ctrl_c_in_the_budgets_checks_keeps_the_draws_and_the_checks_done(tmp_pa
     assert "interrupted (Ctrl-C) after" in err
     assert "**Incomplete:** interrupted after" in (out / "budget.md").read_text()
     assert _group_gone(proc.pid)
+    assert (out / "budget_checks.json").exists()
+    # resumed: the checks done kept, the others run
+    capsys.readouterr()
+    args = ["campaign", str(f), "--budget", "200", "--checks", "8", "--workers", "2"]
+    assert cli.main([*args, "--out", str(out)]) == 0
+    assert f"{len(res['checks'])} of 8 check(s) kept from the run that stopped" in capsys.readouterr().out
+    resumed = _json(out / "budget.json")
+    assert resumed["complete"] is True and len(resumed["checks"]) == 8 and not (out / "budget_checks.json").exists()
+    assert resumed["checks"][:len(res["checks"])] == res["checks"]
+    # the same as a run never stopped, bit for bit (seconds aside)
+    assert cli.main([*args, "--out", str(tmp_path / "fresh")]) == 0
+    fresh = _json(tmp_path / "fresh" / "budget.json")
+    def figures(r):
+        return [{k: v for k, v in c.items() if k != "seconds"} for c in r["checks"]], r["points"]
+    assert figures(resumed) == figures(fresh)
