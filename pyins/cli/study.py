@@ -224,8 +224,10 @@ def _campaign_by_budget(args, camp, out):
     bad = [c for c in res["checks"] if abs(c["rel"]) > 0.01]
     if bad:
         own = [c for c in bad if c["same_table"]]
+        worst = max(bad, key=lambda c: abs(c["rel"]))
         warnings.append(f"{len(bad)} of {len(res['checks'])} check(s) differ from the closed loop by more than "
-                        f"1 % (largest {100 * max(abs(c['rel']) for c in bad):.2f} %): "
+                        f"1 % (largest {100 * abs(worst['rel']):.2f} %, "
+                        f"{abs(worst['budget_m'] - worst['closed_loop_m']):.1f} m on {worst['closed_loop_m']:.1f} m): "
                         + (f"in all of them the unit's table turned otherwise than the error-free unit's, "
                            f"whose stops the budget takes (a table steered by the unit's own heading)"
                            if not own else
@@ -261,7 +263,7 @@ def _campaign_by_budget(args, camp, out):
         table = ("yes" if c["same_table"] else "no" if c["table_differs_from_s"] is None
                  else f"no, from {c['table_differs_from_s'] / 3600:.2f} h")
         lines.append(f"| {label} | {c['draw']} | {c['closed_loop_m']:.1f} m | {c['budget_m']:.1f} m | "
-                     f"{100 * c['rel']:+.3f} % | {table} |")
+                     f"{100 * c['rel']:+.3f} % ({c['budget_m'] - c['closed_loop_m']:+.1f} m) | {table} |")
     if warnings:
         lines += ["", *[f"**Warning:** {w}" for w in warnings]]
     os.makedirs(out, exist_ok=True)
