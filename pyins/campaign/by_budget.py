@@ -33,8 +33,10 @@ and differed by up to 8.0 % for the literal flexible scheme, up to 131 %
 for the derivation form).
 
 The checks: ``checks`` distinct (grid point, draw) pairs picked at random
-without replacement (a fixed seed), each run in the closed loop with that draw's constants and no noise,
-against the budget's noise-free value. The figure is the final horizontal
+without replacement (a fixed seed), each run in the closed loop with that
+draw's constants and no noise, against the budget's noise-free value
+(saved as they finish, so a run stopped part-way resumes: ``kept``,
+``on_check``). The figure is the final horizontal
 error; the budget gives no maximum over time with noise (the noise is a
 process, its covariance gives the final spread only). Each check also says
 whether its table turned as the error-free unit's (the same true table
