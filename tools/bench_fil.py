@@ -132,10 +132,15 @@ def dump_inputs(out_dir, n, scheme=4):
     return info
 
 
-def _lat_of(stdout):
-    """(ticks, lat_rad) from fil_count's line `ticks N lat X ...`."""
+def _after(stdout, name):
+    """The word after ``name`` in fil_count's line `ticks N lat X ... loop_s T`."""
     words = stdout.split()
-    return int(words[words.index("ticks") + 1]), float(words[words.index("lat") + 1])
+    return words[words.index(name) + 1]
+
+
+def _lat_of(stdout):
+    """(ticks, lat_rad) from fil_count's line."""
+    return int(_after(stdout, "ticks")), float(_after(stdout, "lat"))
 
 
 def _check_lat(what, stdout, info):
@@ -179,12 +184,6 @@ def _inclusive(out_file, names):
     return {k: found.get(k) for k in names}
 
 
-def _loop_s(stdout):
-    """fil_count's wall time of the pyins_fil_run call (its ``loop_s X``)."""
-    words = stdout.split()
-    return float(words[words.index("loop_s") + 1])
-
-
 #: --schemes: (indexing scheme, name), the table at rest first
 SCHEMES = ((0, "none (table at rest)"), (2, "traditional two-position"), (4, "flexible two-position"))
 
@@ -213,7 +212,7 @@ def time_schemes(hours, rounds, dump_root):
             if res.returncode != 0:
                 raise SystemExit(f"FAIL: fil_count exited {res.returncode}: {res.stderr.strip()}")
             _check_lat(f"fil_count, scheme {scheme}", res.stdout, infos[scheme])
-            times[scheme].append(_loop_s(res.stdout))
+            times[scheme].append(float(_after(res.stdout, "loop_s")))
     rest = float(np.median(times[0])) / n
     fig = {"schemes_hours": hours, "schemes_rounds": rounds}
     print(f"  {'scheme':26s} {'ns/tick':>8s} {'range':>15s} {'/ none':>7s} {'turning':>8s}")
@@ -312,12 +311,7 @@ def main(argv=None):
         hours = args.hours if args.hours is not None else 6.0
         if not hours > 0:
             ap.error("--hours must be > 0")
-        fig = {}
-        if os.path.exists(args.json):
-            with open(args.json) as f:
-                fig = json.load(f)
-        fig.update(time_schemes(hours, args.rounds, args.dump or str(BUILD / "fil_schemes")))
-        _write_json(args.json, fig)
+        _add_to_json(args.json, time_schemes(hours, args.rounds, args.dump or str(BUILD / "fil_schemes")))
         return 0
     if args.count or args.dump:
         hours = args.hours if args.hours is not None else 0.5
@@ -328,12 +322,7 @@ def main(argv=None):
             return 0
         counted = count_instructions(hours, dump_dir)
         if counted is not None:
-            fig = {}
-            if os.path.exists(args.json):
-                with open(args.json) as f:
-                    fig = json.load(f)
-            fig.update(counted)
-            _write_json(args.json, fig)
+            _add_to_json(args.json, counted)
         return 0
     args.hours = args.hours if args.hours is not None else 72.0
     m, errors, cfg, _, _ = the_case()
@@ -409,6 +398,15 @@ def main(argv=None):
         fig.update(counted)
     _write_json(args.json, fig)
     return 0
+
+
+def _add_to_json(path, fig):
+    """The figures ``fig`` added to those already in the JSON at ``path``."""
+    old = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            old = json.load(f)
+    _write_json(path, {**old, **fig})
 
 
 def _write_json(path, fig):

@@ -31,8 +31,9 @@ Checks (the budget's own test): --checks distinct (group, draw) pairs
 picked at random (seeded), each run in the closed loop with that draw's
 constants and no noise, against the budget's noise-free value: the
 relative difference of the final horizontal error, and whether the check's
-table turned as the error-free unit's whose history the budget takes. And the distributions: over draws 0..99 the
-budget's values (noise drawn from the covariance) against the closed-loop
+table turned as the error-free unit's whose history the budget takes. And
+the distributions: over draws 0..99 the budget's values (noise drawn from
+the covariance) against the closed-loop
 Monte Carlo already on disk (--closed-loop: the runs of
 `tools/papers/montecarlo.py seed002`, noise seed d), a two-sample
 Kolmogorov-Smirnov test per group (scipy.stats.ks_2samp; p < 0.05 says the
